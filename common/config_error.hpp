@@ -1,0 +1,59 @@
+#pragma once
+// Errors raised while loading or validating configuration.
+//
+// A FieldError names the dotted field path, the offending value and the
+// reason, e.g. `agent.inter_distance_m = -4: must be > 0`. The loader adds
+// the file and line, so users see one line they can act on.
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace ddswarm {
+
+/// A configuration field holds a bad value. what() is "field = value: reason".
+class FieldError : public std::runtime_error {
+ public:
+  FieldError(std::string field, const std::string& value, const std::string& reason)
+      : std::runtime_error(field + " = " + value + ": " + reason), field_(std::move(field)) {}
+  const std::string& field() const { return field_; }
+
+ private:
+  std::string field_;
+};
+
+/// A configuration file could not be used. what() is "file:line: message".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <class T>
+std::string to_text(const T& v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+/// Throws FieldError unless lo <= v <= hi.
+template <class T>
+void check_range(const std::string& field, T v, T lo, T hi) {
+  if (!(v >= lo && v <= hi))
+    throw FieldError(field, to_text(v), "must be in [" + to_text(lo) + ", " + to_text(hi) + "]");
+}
+
+/// Throws FieldError unless v > 0 (and finite).
+template <class T>
+void check_positive(const std::string& field, T v) {
+  if (!(v > 0) || v != v || v > std::numeric_limits<T>::max())
+    throw FieldError(field, to_text(v), "must be > 0");
+}
+
+/// Throws FieldError unless v >= 0 (and finite).
+template <class T>
+void check_non_negative(const std::string& field, T v) {
+  if (!(v >= 0) || v > std::numeric_limits<T>::max())
+    throw FieldError(field, to_text(v), "must be >= 0");
+}
+
+}  // namespace ddswarm
