@@ -1,0 +1,89 @@
+#include "common/dds_config.hpp"
+
+#include <CLI/CLI.hpp>
+#include <arpa/inet.h>
+
+#include "common/yaml_section.hpp"
+
+namespace ddswarm {
+namespace {
+bool is_ipv4(const std::string& s) {
+  in_addr a{};
+  return inet_pton(AF_INET, s.c_str(), &a) == 1;
+}
+std::string host_of(const std::string& s) { return s.substr(0, s.find(':')); }
+}  // namespace
+
+void load(YamlSection s, DdsConfig& c) {
+  s.get("domain_id", c.domain_id);
+  s.get_enum("discovery", c.discovery,
+             {{"localhost", Discovery::kLocalhost},
+              {"interface", Discovery::kInterface},
+              {"peers", Discovery::kPeers},
+              {"discovery_server", Discovery::kDiscoveryServer}});
+  s.get("interface_ip", c.interface_ip);
+  s.get("peers", c.peers);
+  s.get("discovery_server", c.discovery_server);
+  s.get("shared_memory", c.shared_memory);
+  s.get("participant_id", c.participant_id);
+  s.get("lease_duration_s", c.lease_duration_s);
+  s.get("profiles_file", c.profiles_file);
+  s.finish();
+}
+
+void DdsConfig::validate() const {
+  check_range("dds.domain_id", domain_id, 0, 232);
+  check_range("dds.participant_id", participant_id, -1, 119);
+  if (!(lease_duration_s >= 1.0 && lease_duration_s <= 300.0))
+    throw FieldError("dds.lease_duration_s", to_text(lease_duration_s), "must be in [1, 300]");
+  if (discovery == Discovery::kInterface || discovery == Discovery::kPeers) {
+    if (!is_ipv4(interface_ip))
+      throw FieldError("dds.interface_ip", interface_ip.empty() ? "(empty)" : interface_ip,
+                       "must be this host's IPv4 address on the chosen network");
+  }
+  if (discovery == Discovery::kPeers) {
+    if (peers.empty()) throw FieldError("dds.peers", "(empty)", "list at least one peer address");
+    for (const auto& p : peers)
+      if (!is_ipv4(host_of(p))) throw FieldError("dds.peers", p, "must be an IPv4 address");
+  }
+  if (discovery == Discovery::kDiscoveryServer && !is_ipv4(host_of(discovery_server)))
+    throw FieldError("dds.discovery_server", discovery_server.empty() ? "(empty)" : discovery_server,
+                     "must be ip:port");
+}
+
+void add_dds_options(CLI::App& app, DdsConfig& c) {
+  app.add_option("--domain", c.domain_id, "DDS domain id (0-232)");
+  app.add_option_function<std::string>(
+         "--dds-interface",
+         [&c](const std::string& ip) {
+           c.discovery = Discovery::kInterface;
+           c.interface_ip = ip;
+         },
+         "opt in to another network: this host's IPv4 address on it (multicast discovery there)")
+      ->group("Networking (default: this machine only)");
+  app.add_option_function<std::vector<std::string>>(
+         "--dds-peers",
+         [&c](const std::vector<std::string>& p) {
+           c.discovery = Discovery::kPeers;
+           c.peers = p;
+         },
+         "opt in: unicast discovery to these peer IPv4 addresses (needs --dds-local-ip)")
+      ->delimiter(',')
+      ->group("Networking (default: this machine only)");
+  app.add_option("--dds-local-ip", c.interface_ip, "with --dds-peers: this host's address")
+      ->group("Networking (default: this machine only)");
+  app.add_option_function<std::string>(
+         "--discovery-server",
+         [&c](const std::string& s) {
+           c.discovery = Discovery::kDiscoveryServer;
+           c.discovery_server = s;
+         },
+         "use a Fast DDS discovery server at ip:port")
+      ->group("Networking (default: this machine only)");
+  app.add_option("--dds-profiles", c.profiles_file, "QoS profiles XML")
+      ->group("Networking (default: this machine only)");
+  app.add_option("--participant-id", c.participant_id, "RTPS participant id (-1 automatic)")
+      ->group("Networking (default: this machine only)");
+}
+
+}  // namespace ddswarm

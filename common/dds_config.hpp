@@ -1,0 +1,45 @@
+#pragma once
+// How a process joins the swarm's DDS domain.
+//
+// The default reaches nothing but this machine: shared memory plus UDPv4
+// bound to 127.0.0.1. Other hosts are reached only when the user names an
+// interface, a list of peers, or a discovery server (docs/networking.md).
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace ddswarm {
+
+class YamlSection;
+
+enum class Discovery {
+  kLocalhost,        ///< default: SHM + UDP on 127.0.0.1 only
+  kInterface,        ///< opt-in: multicast discovery on one named interface address
+  kPeers,            ///< opt-in: unicast discovery to a static list of peer addresses
+  kDiscoveryServer,  ///< opt-in: Fast DDS discovery server at ip:port
+};
+
+struct DdsConfig {
+  int domain_id = 0;                  ///< DDS domain, [0, 232]
+  Discovery discovery = Discovery::kLocalhost;
+  std::string interface_ip;           ///< kInterface/kPeers: the local address to use, e.g. 10.10.0.2
+  std::vector<std::string> peers;     ///< kPeers: peer addresses "ip" (or "ip:port" for one port)
+  std::string discovery_server;       ///< kDiscoveryServer: "ip:port" (port default 11811)
+  bool shared_memory = true;          ///< add the SHM transport (same host only)
+  int participant_id = -1;            ///< RTPS participant id, -1 = automatic; set explicitly past ~100 participants per host
+  double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement
+  std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles
+
+  void validate() const;  ///< throws FieldError("dds.…")
+};
+
+void load(YamlSection s, DdsConfig& c);
+
+/// Adds --domain, --dds-interface, --dds-peers, --discovery-server, --dds-profiles
+/// to a CLI11 app; their values override the YAML's after parsing.
+void add_dds_options(CLI::App& app, DdsConfig& c);
+
+}  // namespace ddswarm

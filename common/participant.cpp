@@ -1,0 +1,124 @@
+#include "common/participant.hpp"
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+
+namespace ddswarm {
+namespace {
+
+using eprosima::fastdds::rtps::SharedMemTransportDescriptor;
+using eprosima::fastdds::rtps::UDPv4TransportDescriptor;
+using eprosima::fastrtps::rtps::IPLocator;
+using eprosima::fastrtps::rtps::Locator_t;
+
+constexpr const char* kLoopback = "127.0.0.1";
+
+void load_profiles_once(const std::string& file) {
+  static std::mutex mu;
+  static std::string loaded;
+  std::lock_guard<std::mutex> lock(mu);
+  if (loaded == file) return;
+  auto rc = fdds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file);
+  if (rc != ReturnCode_t::RETCODE_OK) throw DdsError("cannot load DDS QoS profiles from " + file);
+  loaded = file;
+}
+
+Locator_t udp_locator(const std::string& ip, uint32_t port) {
+  Locator_t l;
+  l.kind = LOCATOR_KIND_UDPv4;
+  IPLocator::setIPv4(l, ip);
+  l.port = port;
+  return l;
+}
+
+/// Builds participant QoS whose every transport is bound to what cfg allows.
+fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& name) {
+  fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
+  qos.name(name);
+  auto& wp = qos.wire_protocol();
+  wp.participant_id = cfg.participant_id;
+  wp.builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(cfg.lease_duration_s);
+  wp.builtin.discovery_config.leaseDuration_announcementperiod =
+      eprosima::fastrtps::Duration_t(cfg.lease_duration_s / 3.0);
+
+  // Never the built-in all-interfaces transports.
+  qos.transport().use_builtin_transports = false;
+  qos.transport().user_transports.clear();
+
+  auto udp = std::make_shared<UDPv4TransportDescriptor>();
+  udp->interfaceWhiteList.clear();
+  udp->interfaceWhiteList.emplace_back(kLoopback);
+  // Room for the whole swarm's state in one UDP datagram train; large samples fragment.
+  udp->sendBufferSize = 1 << 21;
+  udp->receiveBufferSize = 1 << 21;
+
+  switch (cfg.discovery) {
+    case Discovery::kLocalhost:
+      // Same-host discovery: SHM multicast plus unicast pings to 127.0.0.1.
+      wp.builtin.initialPeersList.push_back(udp_locator(kLoopback, 0));
+      break;
+    case Discovery::kInterface:
+      udp->interfaceWhiteList.emplace_back(cfg.interface_ip);
+      break;
+    case Discovery::kPeers: {
+      udp->interfaceWhiteList.emplace_back(cfg.interface_ip);
+      for (const auto& p : cfg.peers) {
+        auto colon = p.find(':');
+        uint32_t port = colon == std::string::npos ? 0 : std::stoul(p.substr(colon + 1));
+        wp.builtin.initialPeersList.push_back(udp_locator(p.substr(0, colon), port));
+      }
+      wp.builtin.initialPeersList.push_back(udp_locator(kLoopback, 0));
+      // Unicast only: no multicast announcements on the opted-in network.
+      wp.builtin.metatrafficMulticastLocatorList.clear();
+      wp.builtin.metatrafficUnicastLocatorList.push_back(udp_locator(cfg.interface_ip, 0));
+      break;
+    }
+    case Discovery::kDiscoveryServer: {
+      auto colon = cfg.discovery_server.find(':');
+      std::string ip = cfg.discovery_server.substr(0, colon);
+      uint32_t port = colon == std::string::npos ? 11811 : std::stoul(cfg.discovery_server.substr(colon + 1));
+      if (ip != kLoopback) udp->interfaceWhiteList.emplace_back(ip == "0.0.0.0" ? kLoopback : ip);
+      eprosima::fastrtps::rtps::RemoteServerAttributes server;
+      server.ReadguidPrefix("44.53.00.5f.45.50.52.4f.53.49.4d.41");  // fast-discovery-server -i 0
+      server.metatrafficUnicastLocatorList.push_back(udp_locator(ip, port));
+      wp.builtin.discovery_config.discoveryProtocol =
+          eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT;
+      wp.builtin.discovery_config.m_DiscoveryServers.push_back(server);
+      break;
+    }
+  }
+  // Give the initial-peers scan room for a large swarm on one host.
+  udp->maxInitialPeersRange = 120;
+
+  if (cfg.shared_memory) {
+    auto shm = std::make_shared<SharedMemTransportDescriptor>();
+    shm->segment_size(4 * 1024 * 1024);
+    qos.transport().user_transports.push_back(shm);
+  }
+  qos.transport().user_transports.push_back(udp);
+  return qos;
+}
+
+}  // namespace
+
+Participant::Participant(const DdsConfig& cfg, const std::string& name) {
+  cfg.validate();
+  load_profiles_once(cfg.profiles_file);
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  participant_ = factory->create_participant(cfg.domain_id, make_qos(cfg, name));
+  if (!participant_)
+    throw DdsError("cannot create DDS participant on domain " + std::to_string(cfg.domain_id));
+  publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  if (!publisher_ || !subscriber_) throw DdsError("cannot create DDS publisher/subscriber");
+}
+
+Participant::~Participant() {
+  if (!participant_) return;
+  participant_->delete_contained_entities();
+  fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+}  // namespace ddswarm

@@ -1,0 +1,138 @@
+#pragma once
+// DDS plumbing: one Participant per process, typed writers and readers.
+//
+// The participant's transports come from DdsConfig (localhost-only unless the
+// user opts in); QoS comes from the XML profiles named in common/topics.hpp.
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <atomic>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "common/dds_config.hpp"
+#include "common/topics.hpp"
+
+namespace ddswarm {
+
+namespace fdds = eprosima::fastdds::dds;
+
+/// A DDS failure during setup (what() names what failed).
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <class T>
+class Writer {
+ public:
+  explicit Writer(fdds::DataWriter* w) : w_(w) {}
+  /// Returns false when DDS refused the sample.
+  bool write(const T& sample) { return w_->write(const_cast<T*>(&sample)); }
+  /// Number of matched readers.
+  int matched() const {
+    fdds::PublicationMatchedStatus s;
+    w_->get_publication_matched_status(s);
+    return s.current_count;
+  }
+  fdds::DataWriter* raw() const { return w_; }
+
+ private:
+  fdds::DataWriter* w_;
+};
+
+/// Called from a Fast DDS thread for every valid sample.
+template <class T>
+using SampleHandler = std::function<void(const T&, const fdds::SampleInfo&)>;
+
+template <class T>
+class Reader : public fdds::DataReaderListener {
+ public:
+  explicit Reader(SampleHandler<T> h) : handler_(std::move(h)) {}
+  void attach(fdds::DataReader* r) { r_ = r; }
+  fdds::DataReader* raw() const { return r_; }
+  int matched() const { return matched_.load(); }
+
+  void on_data_available(fdds::DataReader* reader) override {
+    T sample;
+    fdds::SampleInfo info;
+    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data && handler_) handler_(sample, info);
+    }
+  }
+  void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {
+    matched_ = s.current_count;
+  }
+
+ private:
+  SampleHandler<T> handler_;
+  fdds::DataReader* r_ = nullptr;
+  std::atomic<int> matched_{0};
+};
+
+class Participant {
+ public:
+  /// Joins the domain; throws DdsError naming what failed. name shows in tools.
+  Participant(const DdsConfig& cfg, const std::string& name);
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  template <class T>
+  Writer<T> writer() {
+    auto* topic = topic_for<T>();
+    auto* w = publisher_->create_datawriter_with_profile(topic, Topic<T>::profile);
+    if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name);
+    return Writer<T>(w);
+  }
+
+  /// Creates a reader whose handler runs on a Fast DDS thread for each sample.
+  template <class T>
+  Reader<T>& reader(SampleHandler<T> handler) {
+    auto* topic = topic_for<T>();
+    auto listener = std::make_unique<Reader<T>>(std::move(handler));
+    auto* r = subscriber_->create_datareader_with_profile(topic, Topic<T>::profile, listener.get());
+    if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name);
+    listener->attach(r);
+    auto& ref = *listener;
+    listeners_.push_back(std::move(listener));
+    return ref;
+  }
+
+  fdds::DomainParticipant* raw() const { return participant_; }
+
+ private:
+  template <class T>
+  fdds::Topic* topic_for() {
+    std::lock_guard<std::mutex> lock(mu_);
+    auto it = topics_.find(Topic<T>::name);
+    if (it != topics_.end()) return it->second;
+    fdds::TypeSupport ts(new typename Topic<T>::PubSub());
+    if (ts.register_type(participant_) != ReturnCode_t::RETCODE_OK &&
+        !participant_->find_type(ts.get_type_name()))
+      throw DdsError(std::string("cannot register type for ") + Topic<T>::name);
+    auto* t = participant_->create_topic(Topic<T>::name, ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+    if (!t) throw DdsError(std::string("cannot create topic ") + Topic<T>::name);
+    topics_[Topic<T>::name] = t;
+    return t;
+  }
+
+  fdds::DomainParticipant* participant_ = nullptr;
+  fdds::Publisher* publisher_ = nullptr;
+  fdds::Subscriber* subscriber_ = nullptr;
+  std::mutex mu_;
+  std::map<std::string, fdds::Topic*> topics_;
+  std::vector<std::unique_ptr<fdds::DataReaderListener>> listeners_;
+};
+
+}  // namespace ddswarm

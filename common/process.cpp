@@ -1,0 +1,73 @@
+#include "common/process.hpp"
+
+#include <atomic>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <algorithm>
+#include <exception>
+#include <mutex>
+
+#include "common/config_error.hpp"
+
+namespace ddswarm {
+namespace {
+std::atomic<bool> g_stop{false};
+std::mutex g_mu;
+std::condition_variable g_cv;
+
+extern "C" void on_signal(int) { g_stop.store(true); }
+}  // namespace
+
+void install_stop_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+}
+
+bool stop_requested() { return g_stop.load(); }
+
+void request_stop() {
+  g_stop.store(true);
+  g_cv.notify_all();
+}
+
+bool wait_for_stop(std::chrono::duration<double> d) {
+  // Signal handlers cannot notify a condition variable; poll in short slices.
+  auto end = std::chrono::steady_clock::now() +
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
+  std::unique_lock<std::mutex> lock(g_mu);
+  while (!g_stop.load()) {
+    auto now = std::chrono::steady_clock::now();
+    if (now >= end) break;
+    std::chrono::steady_clock::duration slice = std::chrono::milliseconds(50);
+    g_cv.wait_for(lock, std::min(slice, end - now));
+  }
+  return g_stop.load();
+}
+
+int run_main(const char* prog, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "%s: error: %s\n", prog, e.what());
+    return 2;
+  } catch (const FieldError& e) {
+    std::fprintf(stderr, "%s: error: %s\n", prog, e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", prog, e.what());
+    return 1;
+  }
+}
+
+double wall_seconds() {
+  using namespace std::chrono;
+  static const auto t0 = steady_clock::now();
+  return duration<double>(steady_clock::now() - t0).count();
+}
+
+}  // namespace ddswarm

@@ -1,0 +1,24 @@
+#pragma once
+// Process lifecycle shared by every executable: stop on SIGINT/SIGTERM,
+// turn exceptions into one line and an exit code.
+#include <chrono>
+#include <functional>
+
+namespace ddswarm {
+
+/// Installs SIGINT/SIGTERM handlers that request a stop (idempotent).
+void install_stop_signals();
+/// True once a stop was requested (signal or request_stop()).
+bool stop_requested();
+void request_stop();
+/// Sleeps until a stop is requested or d elapses; returns stop_requested().
+bool wait_for_stop(std::chrono::duration<double> d);
+
+/// Runs body; maps ConfigError/CLI errors to exit 2, other exceptions to exit 1,
+/// printing "<prog>: error: <what>" on one line.
+int run_main(const char* prog, const std::function<int()>& body);
+
+/// Wall-clock seconds since an arbitrary fixed start (monotonic).
+double wall_seconds();
+
+}  // namespace ddswarm

@@ -1,0 +1,42 @@
+#pragma once
+// The one place that names every topic, its type and its QoS profile.
+#include "AgentStatusPubSubTypes.h"
+#include "CollisionEventPubSubTypes.h"
+#include "DistanceScanPubSubTypes.h"
+#include "DroneStatePubSubTypes.h"
+#include "MissionAckPubSubTypes.h"
+#include "MissionCommandPubSubTypes.h"
+#include "ScenePubSubTypes.h"
+#include "SimStatusPubSubTypes.h"
+#include "SwarmStatePubSubTypes.h"
+#include "TaskStatusPubSubTypes.h"
+#include "VelocityCommandPubSubTypes.h"
+
+namespace ddswarm {
+
+template <class T>
+struct Topic;
+
+#define DDSWARM_TOPIC(Type, topic_name, qos_profile)            \
+  template <>                                                    \
+  struct Topic<msg::Type> {                                      \
+    using PubSub = msg::Type##PubSubType;                        \
+    static constexpr const char* name = topic_name;              \
+    static constexpr const char* profile = qos_profile;          \
+  }
+
+DDSWARM_TOPIC(SwarmState, "ddswarm/swarm_state", "state");
+DDSWARM_TOPIC(DroneState, "ddswarm/drone_state", "state_keyed");
+DDSWARM_TOPIC(DistanceScan, "ddswarm/scan", "state_keyed");
+DDSWARM_TOPIC(Scene, "ddswarm/scene", "latched");
+DDSWARM_TOPIC(SimStatus, "ddswarm/status", "status");
+DDSWARM_TOPIC(CollisionEvent, "ddswarm/collision", "events");
+DDSWARM_TOPIC(TaskStatus, "ddswarm/task", "latched");
+DDSWARM_TOPIC(VelocityCommand, "ddswarm/velocity_cmd", "command");
+DDSWARM_TOPIC(AgentStatus, "ddswarm/agent_status", "heartbeat");
+DDSWARM_TOPIC(MissionCommand, "ddswarm/mission", "mission");
+DDSWARM_TOPIC(MissionAck, "ddswarm/mission_ack", "events");
+
+#undef DDSWARM_TOPIC
+
+}  // namespace ddswarm
