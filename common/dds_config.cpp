@@ -87,3 +87,17 @@ void add_dds_options(CLI::App& app, DdsConfig& c) {
 }
 
 }  // namespace ddswarm
+
+namespace ddswarm {
+void merge_cli(DdsConfig& target, const DdsConfig& cli, const CLI::App& app) {
+  if (app.count("--domain")) target.domain_id = cli.domain_id;
+  if (app.count("--dds-interface") || app.count("--dds-peers") || app.count("--discovery-server")) {
+    target.discovery = cli.discovery;
+    target.peers = cli.peers;
+    target.discovery_server = cli.discovery_server;
+  }
+  if (app.count("--dds-interface") || app.count("--dds-local-ip")) target.interface_ip = cli.interface_ip;
+  if (app.count("--dds-profiles")) target.profiles_file = cli.profiles_file;
+  if (app.count("--participant-id")) target.participant_id = cli.participant_id;
+}
+}  // namespace ddswarm

@@ -43,3 +43,9 @@ void load(YamlSection s, DdsConfig& c);
 void add_dds_options(CLI::App& app, DdsConfig& c);
 
 }  // namespace ddswarm
+
+namespace ddswarm {
+/// Copies into target the DDS options the user actually gave on the command
+/// line (cli was bound with add_dds_options), so flags override the YAML.
+void merge_cli(DdsConfig& target, const DdsConfig& cli, const CLI::App& app);
+}  // namespace ddswarm

@@ -58,3 +58,12 @@ struct MissionAck {
 };
 
 }  // namespace ddswarm
+
+namespace ddswarm {
+/// Default size epsilon (m) of the task's swarm condition (thesis Eq. 3.1)
+/// for inter-drone distance d_int: 2 * D_int + 1 m. Why: six drones under
+/// the default linear law settle as a pentagon around a centre drone whose
+/// widest pair is ~1.53 D_int; 2 D_int + 1 m stops the timer once the
+/// gathering has converged to within about one spacing (agent/swarm_law.hpp).
+inline double default_epsilon(double d_int_m) { return 2.0 * d_int_m + 1.0; }
+}  // namespace ddswarm

@@ -1,0 +1,45 @@
+#pragma once
+// The agent process: one drone's brain. It turns what it receives over DDS
+// (its state and scan, peers, mission commands) into a velocity command.
+#include <memory>
+#include <string>
+
+#include "agent/agent_config.hpp"
+#include "common/dds_config.hpp"
+#include "common/scenario.hpp"
+
+namespace ddswarm::agent {
+
+/// Everything the agent reads from a scenario file.
+struct AgentAppConfig {
+  ScenarioConfig scenario;
+  AgentConfig agent;
+  DdsConfig dds;
+  int drone_id = 0;              ///< which drone this agent flies, [0, scenario.drones)
+  double duplicate_probe_s = 1.0;///< s wall: listen for another agent on this id before flying
+  void validate() const;
+};
+
+/// Loads the scenario's scenario/agent/dds sections; throws ConfigError.
+AgentAppConfig load_agent_config(const std::string& path);
+
+/// Raised when another live agent already flies this drone id.
+class DuplicateAgent : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class AgentApp {
+ public:
+  /// Joins DDS and checks that no other agent flies this drone (throws DuplicateAgent).
+  explicit AgentApp(AgentAppConfig cfg);
+  ~AgentApp();
+  /// Runs until stop_requested() or duration_s of wall time (<= 0: forever).
+  void run(double duration_s);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ddswarm::agent

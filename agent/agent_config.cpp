@@ -1,0 +1,170 @@
+#include "agent/agent_config.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace ddswarm::agent {
+namespace {
+
+std::string point_text(const Eigen::Vector2d& p) {
+  return "[" + to_text(p.x()) + ", " + to_text(p.y()) + "]";
+}
+
+std::string point_field(const std::string& prefix, std::size_t i) {
+  return prefix + ".points[" + std::to_string(i) + "]";
+}
+
+void check_increasing(const std::string& prefix, const std::vector<Eigen::Vector2d>& pts) {
+  if (pts.size() < 2)
+    throw FieldError(prefix + ".points", std::to_string(pts.size()) + " points",
+                     "a custom curve needs at least 2 points");
+  for (std::size_t i = 1; i < pts.size(); ++i)
+    if (!(pts[i].x() > pts[i - 1].x()))
+      throw FieldError(point_field(prefix, i), point_text(pts[i]),
+                       "points must be sorted by strictly increasing distance");
+}
+
+}  // namespace
+
+void ActivationConfig::validate() const {
+  const std::string p = "agent.activation";
+  check_positive(p + ".attraction_gain", attraction_gain);
+  check_positive(p + ".repulsion_gain", repulsion_gain);
+  if (repulsion_gain < attraction_gain)
+    throw FieldError(p + ".repulsion_gain", to_text(repulsion_gain),
+                     "must be >= attraction_gain (" + to_text(attraction_gain) +
+                         "): repulsion must be the stronger force for the drones' safety");
+  check_positive(p + ".max_mps", max_mps);
+  check_non_negative(p + ".cutoff_m", cutoff_m);
+  if (type == ActivationType::kLinear) {
+    if (!points.empty())
+      throw FieldError(p + ".points", std::to_string(points.size()) + " points",
+                       "only used with type: custom");
+    return;
+  }
+  check_increasing(p, points);
+  bool origin = false, below = false, above = false;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = points[i].x(), f = points[i].y();
+    if (d == 0.0) {
+      if (f != 0.0)
+        throw FieldError(point_field(p, i), point_text(points[i]),
+                         "the curve must pass through (0, 0): no force at D_int");
+      origin = true;
+    } else if (d < 0.0) {
+      if (!(f < 0.0))
+        throw FieldError(point_field(p, i), point_text(points[i]),
+                         "f must be < 0 (repulsive) where D_r < 0");
+      below = true;
+    } else {
+      if (!(f > 0.0))
+        throw FieldError(point_field(p, i), point_text(points[i]),
+                         "f must be > 0 (attractive) where D_r > 0");
+      above = true;
+    }
+  }
+  if (!origin)
+    throw FieldError(p + ".points", std::to_string(points.size()) + " points",
+                     "the curve must contain the point [0, 0]");
+  if (!below || !above)
+    throw FieldError(p + ".points", std::to_string(points.size()) + " points",
+                     "the curve needs points on both sides of 0 (repulsion and attraction)");
+}
+
+void SensorFunctionConfig::validate() const {
+  const std::string p = "agent.sensor_function";
+  check_positive(p + ".max_mps", max_mps);
+  check_positive(p + ".log_gain_mps", log_gain_mps);
+  check_non_negative(p + ".safety_distance_m", safety_distance_m);
+  if (type != SensorFunctionType::kCustom) {
+    if (!points.empty())
+      throw FieldError(p + ".points", std::to_string(points.size()) + " points",
+                       "only used with type: custom");
+    return;
+  }
+  check_increasing(p, points);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].x() < 0.0)
+      throw FieldError(point_field(p, i), point_text(points[i]), "distance S must be >= 0");
+    if (!(points[i].y() >= 0.0))
+      throw FieldError(point_field(p, i), point_text(points[i]),
+                       "f must be >= 0 (a push away from the obstacle)");
+  }
+  if (points.back().y() != 0.0)
+    throw FieldError(point_field(p, points.size() - 1), point_text(points.back()),
+                     "the last point must have f = 0 (its S is the function's range)");
+}
+
+void AgentConfig::validate() const {
+  check_positive("agent.inter_distance_m", inter_distance_m);
+  activation.validate();
+  if (activation.cutoff_m > 0 && !(activation.cutoff_m > inter_distance_m))
+    throw FieldError("agent.activation.cutoff_m", to_text(activation.cutoff_m),
+                     "must be 0 (no cutoff) or > inter_distance_m (" + to_text(inter_distance_m) +
+                         "), or drones would never attract");
+  sensor_function.validate();
+  check_positive("agent.max_speed_mps", max_speed_mps);
+  check_positive("agent.altitude_gain", altitude_gain);
+  check_positive("agent.altitude_tolerance_m", altitude_tolerance_m);
+  check_positive("agent.min_altitude_m", min_altitude_m);
+  check_positive("agent.takeoff_altitude_m", takeoff_altitude_m);
+  if (takeoff_altitude_m < min_altitude_m)
+    throw FieldError("agent.takeoff_altitude_m", to_text(takeoff_altitude_m),
+                     "must be >= min_altitude_m (" + to_text(min_altitude_m) + ")");
+  for (auto [name, v] : {std::pair{"agent.takeoff_speed_mps", takeoff_speed_mps},
+                         std::pair{"agent.landing_speed_mps", landing_speed_mps},
+                         std::pair{"agent.task_speed_mps", task_speed_mps}}) {
+    check_positive(name, v);
+    if (v > max_speed_mps)
+      throw FieldError(name, to_text(v),
+                       "must be <= max_speed_mps (" + to_text(max_speed_mps) + ")");
+  }
+  check_positive("agent.teleop_timeout_s", teleop_timeout_s);
+  check_positive("agent.server_timeout_s", server_timeout_s);
+  check_positive("agent.settle_speed_mps", settle_speed_mps);
+}
+
+void load(YamlSection s, ActivationConfig& c) {
+  s.get_enum("type", c.type,
+             {{"linear", ActivationType::kLinear}, {"custom", ActivationType::kCustom}});
+  s.get("attraction_gain", c.attraction_gain);
+  s.get("repulsion_gain", c.repulsion_gain);
+  s.get("max_mps", c.max_mps);
+  s.get("points", c.points);
+  s.get("cutoff_m", c.cutoff_m);
+  s.finish();
+}
+
+void load(YamlSection s, SensorFunctionConfig& c) {
+  s.get_enum("type", c.type,
+             {{"fs1", SensorFunctionType::kFs1},
+              {"fs2", SensorFunctionType::kFs2},
+              {"log", SensorFunctionType::kLog},
+              {"custom", SensorFunctionType::kCustom}});
+  s.get("max_mps", c.max_mps);
+  s.get("log_gain_mps", c.log_gain_mps);
+  s.get("points", c.points);
+  s.get("safety_distance_m", c.safety_distance_m);
+  s.finish();
+}
+
+void load(YamlSection s, AgentConfig& c) {
+  s.get("inter_distance_m", c.inter_distance_m);
+  load(s.child("activation"), c.activation);
+  load(s.child("sensor_function"), c.sensor_function);
+  s.get("max_speed_mps", c.max_speed_mps);
+  s.get("altitude_hold", c.altitude_hold);
+  s.get("altitude_gain", c.altitude_gain);
+  s.get("altitude_tolerance_m", c.altitude_tolerance_m);
+  s.get("min_altitude_m", c.min_altitude_m);
+  s.get("takeoff_altitude_m", c.takeoff_altitude_m);
+  s.get("takeoff_speed_mps", c.takeoff_speed_mps);
+  s.get("landing_speed_mps", c.landing_speed_mps);
+  s.get("task_speed_mps", c.task_speed_mps);
+  s.get("teleop_timeout_s", c.teleop_timeout_s);
+  s.get("server_timeout_s", c.server_timeout_s);
+  s.get("settle_speed_mps", c.settle_speed_mps);
+  s.finish();
+}
+
+}  // namespace ddswarm::agent

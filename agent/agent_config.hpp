@@ -1,0 +1,77 @@
+#pragma once
+// The agent's parameters: YAML section `agent`.
+//
+// One struct per part (activation, sensor function) nested in AgentConfig.
+// Every field has a default; validate() throws FieldError naming the dotted
+// field, e.g. `agent.inter_distance_m = -4: must be > 0`. The shapes of the
+// functions these parameters describe are documented in agent/swarm_law.hpp.
+#include <Eigen/Core>
+#include <vector>
+
+#include "common/yaml_section.hpp"
+
+namespace ddswarm::agent {
+
+enum class ActivationType { kLinear, kCustom };
+
+/// The drone-to-drone activation f_rel(D_r), D_r = |d_i - d_j| - D_int
+/// (thesis §2.4.1, Fig. 3/5). YAML `agent.activation`.
+struct ActivationConfig {
+  ActivationType type = ActivationType::kLinear;  ///< linear | custom
+  double attraction_gain = 0.25;                  ///< 1/s, linear slope for D_r > 0; > 0
+  double repulsion_gain = 1.0;  ///< 1/s, linear slope for D_r < 0; >= attraction_gain
+  double max_mps = 1.5;         ///< m/s, |f_rel| saturation (both types); > 0
+  /// custom: [[D_r m, f m/s], ...], D_r strictly increasing, through (0, 0),
+  /// f < 0 where D_r < 0 and f > 0 where D_r > 0; held flat beyond the ends.
+  std::vector<Eigen::Vector2d> points;
+  double cutoff_m = 0.0;  ///< m, peers farther than this are ignored; 0 = no cutoff; else > D_int
+
+  void validate() const;  ///< throws FieldError("agent.activation.…")
+};
+
+enum class SensorFunctionType { kFs1, kFs2, kLog, kCustom };
+
+/// The obstacle reaction f_s(S) >= 0 (m/s) for one ray reading S (thesis
+/// §2.5, §3.3 Fig. 7/8, §5 Fig. 19). YAML `agent.sensor_function`.
+struct SensorFunctionConfig {
+  SensorFunctionType type = SensorFunctionType::kFs1;  ///< fs1 | fs2 | log | custom
+  double max_mps = 2.0;                                ///< m/s, fs1/fs2 plateau and log clamp; > 0
+  double log_gain_mps = 1.0;  ///< m/s, k in the log function k*ln(S_max/S); > 0
+  /// custom: [[S m, f m/s], ...], S >= 0 strictly increasing, f >= 0, last f = 0
+  /// (its S is the function's range); below the first S the first f holds.
+  std::vector<Eigen::Vector2d> points;
+  /// m, 0 = off. A hit closer than this makes obstacle repulsion dominate:
+  /// the other terms lose their component toward the obstacle and the
+  /// repulsion is raised to agent.max_speed_mps. >= 0.
+  double safety_distance_m = 0.0;
+
+  void validate() const;  ///< throws FieldError("agent.sensor_function.…")
+};
+
+struct AgentConfig {
+  double inter_distance_m = 4.0;  ///< m, D_int, wanted drone-to-drone distance; > 0
+  ActivationConfig activation;
+  SensorFunctionConfig sensor_function;
+  double max_speed_mps = 3.0;  ///< m/s, limit on the commanded speed (horizontal and total); > 0
+  bool altitude_hold = true;   ///< hold cruise altitude (replaces vertical R&A) while airborne
+  double altitude_gain = 1.0;  ///< 1/s, vertical P gain toward the altitude target; > 0
+  double altitude_tolerance_m = 0.1;  ///< m, takeoff is done within this of its altitude; > 0
+  double min_altitude_m = 0.5;        ///< m above ground, lowest cruise altitude (move/hold); > 0
+  double takeoff_altitude_m = 2.0;    ///< m above ground, default takeoff/cruise altitude; >= min
+  double takeoff_speed_mps = 1.0;     ///< m/s, climb rate limit; (0, max_speed]
+  double landing_speed_mps = 0.5;  ///< m/s, descent rate, altitude-hold sink limit; (0, max_speed]
+  double task_speed_mps = 0.8;     ///< m/s, task speed when the command gives 0; (0, max_speed]
+  double teleop_timeout_s = 1.0;   ///< s (sim), leader's teleop velocity drops to 0 after this; > 0
+  double server_timeout_s = 1.0;   ///< s (wall), no server sample for this long -> failsafe; > 0
+  double settle_speed_mps = 0.05;  ///< m/s, below this speed a drone counts as settled; > 0
+
+  void validate() const;  ///< throws FieldError("agent.…")
+};
+
+/// Reads section `agent` (and its `activation`, `sensor_function` children);
+/// unknown keys throw ConfigError with file and line. Does not validate.
+void load(YamlSection s, AgentConfig& c);
+void load(YamlSection s, ActivationConfig& c);
+void load(YamlSection s, SensorFunctionConfig& c);
+
+}  // namespace ddswarm::agent

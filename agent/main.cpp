@@ -1,0 +1,44 @@
+// ddswarm-agent: the brain of one drone, a process of its own.
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <optional>
+
+#include "agent/agent_app.hpp"
+#include "common/process.hpp"
+
+int main(int argc, char** argv) {
+  return ddswarm::run_main("ddswarm-agent", [&] {
+    CLI::App app{"ddswarm-agent: flies one drone by repulsion-attraction and obstacle avoidance"};
+    std::string config;
+    int id = -1;
+    double duration_s = 0;
+    std::optional<int> drones;
+    ddswarm::DdsConfig dds_cli;
+    app.add_option("--id", id, "drone id to fly")->required();
+    app.add_option("--config,config", config, "scenario YAML (its agent: section)")->required();
+    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = until Ctrl-C)");
+    app.add_option("--drones", drones, "override scenario.drones");
+    ddswarm::add_dds_options(app, dds_cli);
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      return app.exit(e) == 0 ? 0 : 2;
+    }
+    auto cfg = ddswarm::agent::load_agent_config(config);
+    cfg.drone_id = id;
+    if (drones) cfg.scenario.drones = *drones;
+    ddswarm::merge_cli(cfg.dds, dds_cli, app);
+    cfg.validate();
+    spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
+    ddswarm::install_stop_signals();
+    try {
+      ddswarm::agent::AgentApp agent(std::move(cfg));
+      agent.run(duration_s);
+    } catch (const ddswarm::agent::DuplicateAgent& e) {
+      std::fprintf(stderr, "ddswarm-agent: error: %s\n", e.what());
+      return 3;
+    }
+    return 0;
+  });
+}

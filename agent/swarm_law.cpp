@@ -1,0 +1,181 @@
+#include "agent/swarm_law.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ddswarm::agent {
+namespace {
+
+constexpr double kTiny = 1e-9;
+
+/// Linear interpolation through points (x increasing), held flat beyond the ends.
+double interpolate(const std::vector<Eigen::Vector2d>& pts, double x) {
+  if (x <= pts.front().x()) return pts.front().y();
+  if (x >= pts.back().x()) return pts.back().y();
+  auto hi = std::upper_bound(pts.begin(), pts.end(), x,
+                             [](double v, const Eigen::Vector2d& p) { return v < p.x(); });
+  auto lo = hi - 1;
+  const double t = (x - lo->x()) / (hi->x() - lo->x());
+  return lo->y() + t * (hi->y() - lo->y());
+}
+
+/// Scales v down so that its norm is at most limit (direction kept).
+template <class V>
+void limit_norm(V&& v, double limit) {
+  const double n = v.norm();
+  if (n > limit && n > 0) v *= limit / n;
+}
+
+}  // namespace
+
+double f_rel(double d_r, const ActivationConfig& a) {
+  if (std::isnan(d_r)) return d_r;
+  double f = 0.0;
+  if (a.type == ActivationType::kCustom && !a.points.empty()) {
+    f = interpolate(a.points, d_r);
+  } else {
+    f = d_r >= 0 ? a.attraction_gain * d_r : a.repulsion_gain * d_r;
+  }
+  return std::clamp(f, -a.max_mps, a.max_mps);
+}
+
+Eigen::Vector3d repulsion_attraction(const Eigen::Vector3d& self,
+                                     std::span<const Eigen::Vector3d> peers, double d_int,
+                                     const ActivationConfig& a) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : peers) {
+    const Eigen::Vector3d delta = p - self;
+    const double dist = delta.norm();
+    if (!(dist > kTiny)) continue;
+    if (a.cutoff_m > 0 && dist > a.cutoff_m) continue;
+    c += f_rel(dist - d_int, a) * (delta / dist);
+  }
+  return c;
+}
+
+double sensor_range_m(const SensorFunctionConfig& s) {
+  switch (s.type) {
+    case SensorFunctionType::kFs1:
+      return kFs1RangeM;
+    case SensorFunctionType::kFs2:
+      return kFs2RangeM;
+    case SensorFunctionType::kLog:
+      return kLogRangeM;
+    case SensorFunctionType::kCustom:
+      return s.points.empty() ? 0.0 : s.points.back().x();
+  }
+  return 0.0;
+}
+
+double sensor_activation(double range_m, bool hit, const SensorFunctionConfig& s) {
+  if (!hit || std::isnan(range_m)) return 0.0;
+  const double r = std::max(range_m, 0.0);
+  const double range = sensor_range_m(s);
+  if (r >= range) return 0.0;
+  switch (s.type) {
+    case SensorFunctionType::kFs1:
+    case SensorFunctionType::kFs2:
+      if (r <= kSensorPlateauM) return s.max_mps;
+      return s.max_mps * (range - r) / (range - kSensorPlateauM);
+    case SensorFunctionType::kLog:
+      if (r <= 0.0) return s.max_mps;
+      return std::min(s.max_mps, s.log_gain_mps * std::log(range / r));
+    case SensorFunctionType::kCustom:
+      return std::max(0.0, interpolate(s.points, r));
+  }
+  return 0.0;
+}
+
+Eigen::Vector3d ray_direction_world(double ray_yaw_body_rad,
+                                    const Eigen::Quaterniond& q_world_body) {
+  const Eigen::Vector3d body(std::cos(ray_yaw_body_rad), std::sin(ray_yaw_body_rad), 0.0);
+  Eigen::Vector3d w = q_world_body * body;
+  w.z() = 0.0;
+  const double n = w.norm();
+  return n > kTiny ? Eigen::Vector3d(w / n) : Eigen::Vector3d::Zero();
+}
+
+Eigen::Vector3d obstacle_avoidance(std::span<const float> range_m,
+                                   std::span<const std::uint8_t> hit,
+                                   std::span<const float> ray_yaw_body_rad,
+                                   const Eigen::Quaterniond& q_world_body,
+                                   const SensorFunctionConfig& s) {
+  if (range_m.size() != hit.size() || range_m.size() != ray_yaw_body_rad.size())
+    throw std::invalid_argument("obstacle_avoidance: ray spans differ in size (range " +
+                                std::to_string(range_m.size()) + ", hit " +
+                                std::to_string(hit.size()) + ", yaw " +
+                                std::to_string(ray_yaw_body_rad.size()) + ")");
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < range_m.size(); ++k) {
+    const double f = sensor_activation(range_m[k], hit[k] != 0, s);
+    if (f > 0) c -= f * ray_direction_world(ray_yaw_body_rad[k], q_world_body);
+  }
+  return c;
+}
+
+LawTerms evaluate_law(const LawInput& in, const AgentConfig& c) {
+  LawTerms t;
+  if (in.swarm_enabled)
+    t.swarm = repulsion_attraction(in.p_world, in.peers_world, in.inter_distance_m, c.activation);
+  Eigen::Vector3d other = t.swarm + in.mission_velocity;
+
+  if (in.obstacle_avoidance_enabled) {
+    t.obstacle = obstacle_avoidance(in.ray_range_m, in.ray_hit, in.ray_yaw_body_rad,
+                                    in.q_world_body, c.sensor_function);
+    const double safety = c.sensor_function.safety_distance_m;
+    if (safety > 0) {
+      Eigen::Vector3d away = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; k < in.ray_range_m.size(); ++k) {
+        const float r = in.ray_range_m[k];
+        if (in.ray_hit[k] == 0 || std::isnan(r) || r >= safety) continue;
+        t.safety_active = true;
+        away -= ray_direction_world(in.ray_yaw_body_rad[k], in.q_world_body);
+      }
+      if (t.safety_active) {
+        // Hits on opposite sides cancel; then fall back on the graded reaction.
+        if (away.norm() < 1e-6) away = t.obstacle;
+        if (away.norm() >= 1e-6) {
+          const Eigen::Vector3d u = away.normalized();
+          const double toward = other.dot(u);
+          if (toward < 0) other -= toward * u;
+          t.obstacle = c.max_speed_mps * u;
+        } else {
+          // Squeezed between opposite hits: no way out, so at least stop closing in.
+          for (std::size_t k = 0; k < in.ray_range_m.size(); ++k) {
+            const float r = in.ray_range_m[k];
+            if (in.ray_hit[k] == 0 || std::isnan(r) || r >= safety) continue;
+            const Eigen::Vector3d d = ray_direction_world(in.ray_yaw_body_rad[k], in.q_world_body);
+            const double toward = other.dot(d);
+            if (toward > 0) other -= toward * d;
+          }
+        }
+      }
+    }
+  }
+
+  Eigen::Vector3d v = t.obstacle + other;
+  if (in.altitude_hold) {
+    const double correction = std::clamp(c.altitude_gain * (in.altitude_target_m - in.p_world.z()),
+                                         -c.landing_speed_mps, c.takeoff_speed_mps);
+    v.z() = in.mission_velocity.z() + correction;
+  }
+  limit_norm(v.head<2>(), c.max_speed_mps);
+  limit_norm(v, c.max_speed_mps);
+  t.velocity = v;
+  return t;
+}
+
+Eigen::Vector3d control_velocity(const LawInput& in, const AgentConfig& c) {
+  return evaluate_law(in, c).velocity;
+}
+
+bool swarm_condition(std::span<const Eigen::Vector3d> positions, double epsilon_m) {
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    for (std::size_t j = i + 1; j < positions.size(); ++j)
+      if (!((positions[i] - positions[j]).norm() < epsilon_m)) return false;
+  return true;
+}
+
+}  // namespace ddswarm::agent

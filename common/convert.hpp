@@ -1,0 +1,41 @@
+#pragma once
+// The edge between generated wire types and the project's plain structs:
+// every conversion happens here, once.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "Geometry.h"
+#include "MissionAck.h"
+#include "MissionCommand.h"
+#include "common/mission.hpp"
+
+namespace ddswarm {
+
+inline Eigen::Vector3d from_msg(const msg::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+inline msg::Vec3 to_msg(const Eigen::Vector3d& v) {
+  msg::Vec3 m;
+  m.x(v.x());
+  m.y(v.y());
+  m.z(v.z());
+  return m;
+}
+inline Eigen::Quaterniond from_msg(const msg::Quat& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+inline msg::Quat to_msg(const Eigen::Quaterniond& q) {
+  msg::Quat m;
+  m.w(q.w());
+  m.x(q.x());
+  m.y(q.y());
+  m.z(q.z());
+  return m;
+}
+
+/// Why a mission command is unacceptable, or empty if it is fine: unknown
+/// type, non-finite or absurd values. Shared by server and agents.
+std::string mission_problem(const msg::MissionCommand& m);
+
+MissionCommand from_msg(const msg::MissionCommand& m);
+msg::MissionCommand to_msg(const MissionCommand& c);
+
+msg::MissionAck to_msg(const MissionAck& a, std::uint64_t issuer_instance);
+
+}  // namespace ddswarm

@@ -1,0 +1,324 @@
+#include "ground_station/dds_commander.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <random>
+#include <set>
+
+#include "common/convert.hpp"
+#include "common/mission.hpp"
+#include "common/participant.hpp"
+#include "common/process.hpp"
+
+namespace ddswarm::gs {
+
+std::string TaskOutcome::line() const {
+  if (!ok) return "task failed: " + reason;
+  return fmt::format(
+      "task complete: {:.2f} s sim time (wall {:.1f} s), {} drones at {:.2f} m/s, collisions: "
+      "obstacle {}, drone {}, ground {}; min inter-drone distance {:.2f} m, min obstacle "
+      "clearance {:.2f} m",
+      task_time_s, wall_time_s, drones, speed_mps, collisions_obstacle, collisions_drone,
+      collisions_ground, min_inter_drone_m, min_clearance_m);
+}
+
+namespace {
+struct AgentSeen {
+  double wall = -1e9;
+  double d_int = 0;
+  Phase phase = Phase::kIdle;
+};
+}  // namespace
+
+struct DdsCommander::Impl {
+  GroundStationConfig cfg;
+  const std::uint64_t instance;
+  Participant dds;
+  Writer<msg::MissionCommand> w_mission;
+
+  mutable std::mutex mu;
+  std::condition_variable cv;
+  std::optional<msg::SimStatus> sim;
+  double sim_wall = -1e9;
+  std::optional<msg::TaskStatus> task;
+  std::map<int, AgentSeen> agents;
+  std::map<std::uint32_t, std::map<int, msg::MissionAck>> acks;  // seq -> drone -> ack
+  std::uint32_t seq = 0;
+  std::uint32_t task_seq = 0;
+  std::optional<TaskOutcome> outcome;
+
+  Impl(const GroundStationConfig& c, const DdsConfig& d)
+      : cfg(c),
+        instance([] {
+          std::random_device rd;
+          return (static_cast<std::uint64_t>(rd()) << 32 | rd()) ^ static_cast<std::uint64_t>(getpid());
+        }()),
+        dds(d, "ddswarm-gs"),
+        w_mission(dds.writer<msg::MissionCommand>()) {
+    // Seqs increase across ground-station sessions too, so agents never
+    // mistake a new session's command for a repeat of an old one.
+    seq = static_cast<std::uint32_t>(std::time(nullptr) % 1000000) * 1000;
+    dds.reader<msg::SimStatus>([this](const msg::SimStatus& s, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(mu);
+      sim = s;
+      sim_wall = wall_seconds();
+      cv.notify_all();
+    });
+    dds.reader<msg::TaskStatus>([this](const msg::TaskStatus& t, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(mu);
+      task = t;
+      cv.notify_all();
+    });
+    dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& a, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(mu);
+      auto& s = agents[a.drone_id()];
+      s.wall = wall_seconds();
+      s.d_int = a.inter_distance_m();
+      s.phase = static_cast<Phase>(a.phase());
+      cv.notify_all();
+    });
+    dds.reader<msg::MissionAck>([this](const msg::MissionAck& a, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(mu);
+      if (a.issuer_instance() != instance) return;
+      acks[a.seq()][a.drone_id()] = a;
+      cv.notify_all();
+    });
+  }
+
+  std::set<int> online_locked() const {
+    std::set<int> out;
+    double now = wall_seconds();
+    for (const auto& [id, s] : agents)
+      if (now - s.wall <= cfg.online_window_s) out.insert(id);
+    return out;
+  }
+
+  double d_int_locked() const {
+    double d = 0;
+    for (const auto& [id, s] : agents) d = std::max(d, s.d_int);
+    return d > 0 ? d : 4.0;
+  }
+
+  CommandResult send(MissionCommand c) {
+    std::unique_lock<std::mutex> lock(mu);
+    c.seq = ++seq;
+    c.issuer = cfg.name;
+    std::set<int> expect = online_locked();
+    if (c.target >= 0) expect = expect.count(c.target) ? std::set<int>{c.target} : std::set<int>{};
+    if (expect.empty()) {
+      return {false, c.target >= 0 ? fmt::format("drone {} is not online", c.target)
+                                   : "no agent is online"};
+    }
+    msg::MissionCommand m = to_msg(c);
+    m.issuer_instance(instance);
+    lock.unlock();
+    if (!w_mission.write(m)) return {false, "DDS refused the command"};
+    lock.lock();
+    const std::uint32_t s = c.seq;
+    cv.wait_for(lock, std::chrono::duration<double>(cfg.ack_timeout_s), [&] {
+      if (stop_requested()) return true;
+      const auto& got = acks[s];
+      for (int id : expect)
+        if (!got.count(id)) return false;
+      return true;
+    });
+    const auto& got = acks[s];
+    std::vector<int> missing;
+    std::string rejected;
+    int accepted = 0;
+    for (int id : expect) {
+      auto it = got.find(id);
+      if (it == got.end()) {
+        missing.push_back(id);
+      } else if (!it->second.accepted()) {
+        rejected += fmt::format("{}rejected by {}: {}", rejected.empty() ? "" : "; ", id,
+                                it->second.reason().to_string());
+      } else {
+        ++accepted;
+      }
+    }
+    CommandResult r;
+    r.ok = missing.empty() && rejected.empty();
+    r.message = fmt::format("{} {}/{} acknowledged", to_string(c.type), accepted, expect.size());
+    if (!missing.empty()) r.message += fmt::format("; no ack from drones {}", fmt::join(missing, ", "));
+    if (!rejected.empty()) r.message += "; " + rejected;
+    if (c.type == MissionType::kTask) task_seq = s;
+    return r;
+  }
+};
+
+DdsCommander::DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds)
+    : impl_(std::make_unique<Impl>(cfg, dds)) {}
+DdsCommander::~DdsCommander() = default;
+
+bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
+  std::unique_lock<std::mutex> lock(impl_->mu);
+  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+    if (stop_requested()) return true;
+    if (!impl_->sim) return false;
+    int want = count >= 0 ? count : impl_->sim->num_drones();
+    return static_cast<int>(impl_->online_locked().size()) >= want &&
+           impl_->w_mission.matched() > 0;
+  }) && !stop_requested();
+}
+
+bool DdsCommander::wait_sim_time(double t, double timeout_s) {
+  std::unique_lock<std::mutex> lock(impl_->mu);
+  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+    return stop_requested() || (impl_->sim && impl_->sim->sim_time_s() >= t);
+  }) && !stop_requested();
+}
+
+bool DdsCommander::wait_airborne(int count, double timeout_s) {
+  std::unique_lock<std::mutex> lock(impl_->mu);
+  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+    return stop_requested() || (impl_->sim && impl_->sim->airborne() == count);
+  }) && !stop_requested();
+}
+
+CommandResult DdsCommander::takeoff(double altitude_m) {
+  MissionCommand c;
+  c.type = MissionType::kTakeoff;
+  c.value = altitude_m;
+  return impl_->send(c);
+}
+
+CommandResult DdsCommander::move(const Eigen::Vector3d& v, double duration_s) {
+  MissionCommand c;
+  c.type = MissionType::kMove;
+  c.velocity = v;
+  c.duration_s = duration_s;
+  return impl_->send(c);
+}
+
+CommandResult DdsCommander::set_distance(double d) {
+  MissionCommand c;
+  c.type = MissionType::kSetDistance;
+  c.value = d;
+  return impl_->send(c);
+}
+
+CommandResult DdsCommander::land() {
+  MissionCommand c;
+  c.type = MissionType::kLand;
+  return impl_->send(c);
+}
+
+CommandResult DdsCommander::follow_leader(int leader) {
+  MissionCommand c;
+  c.type = MissionType::kFollowLeader;
+  c.leader_id = leader;
+  return impl_->send(c);
+}
+
+CommandResult DdsCommander::teleop(const Eigen::Vector3d& v) {
+  MissionCommand c;
+  c.type = MissionType::kTeleop;
+  c.velocity = v;
+  return impl_->send(c);
+}
+
+CommandResult DdsCommander::hold() {
+  MissionCommand c;
+  c.type = MissionType::kHold;
+  return impl_->send(c);
+}
+
+CommandResult DdsCommander::task(double speed, double eps) {
+  MissionCommand c;
+  c.type = MissionType::kTask;
+  c.value = speed > 0 ? speed : TaskConfig{}.speed_mps;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mu);
+    c.epsilon_m = eps > 0 ? eps : default_epsilon(impl_->d_int_locked());
+    impl_->outcome.reset();
+  }
+  return impl_->send(c);
+}
+
+std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_progress) {
+  auto& I = *impl_;
+  std::unique_lock<std::mutex> lock(I.mu);
+  const double start = wall_seconds();
+  double last_progress = start;
+  TaskOutcome o;
+  while (true) {
+    I.cv.wait_for(lock, std::chrono::milliseconds(200));
+    double now = wall_seconds();
+    const bool mine = I.task && I.task->seq() == I.task_seq;
+    if (mine && (I.task->phase() == msg::TASK_COMPLETE || I.task->phase() == msg::TASK_FAILED)) {
+      const auto& t = *I.task;
+      o.ok = t.phase() == msg::TASK_COMPLETE;
+      o.reason = t.reason().to_string();
+      o.task_time_s = t.elapsed_s();
+      o.wall_time_s = t.wall_elapsed_s();
+      o.epsilon_m = t.epsilon_m();
+      o.speed_mps = t.speed_mps();
+      o.drones = t.drones();
+      o.collisions_obstacle = static_cast<int>(t.collisions_obstacle());
+      o.collisions_drone = static_cast<int>(t.collisions_drone());
+      o.collisions_ground = static_cast<int>(t.collisions_ground());
+      o.min_inter_drone_m = t.min_inter_drone_m();
+      o.min_clearance_m = t.min_clearance_m();
+      break;
+    }
+    if (stop_requested()) {
+      o.reason = "interrupted";
+      break;
+    }
+    if (now - start > I.cfg.task_timeout_s) {
+      o.reason = fmt::format("no result within {:.0f} s of wall time", I.cfg.task_timeout_s);
+      break;
+    }
+    if (now - I.sim_wall > 3.0) {
+      o.reason = "server lost (no status for 3 s)";
+      break;
+    }
+    if (on_progress && now - last_progress >= 2.0 && mine) {
+      last_progress = now;
+      std::string p = fmt::format("t={:.1f} s: {}/{} past finish, widest pair {:.1f} m (epsilon {:.1f} m)",
+                                  I.task->elapsed_s(), I.task->past_finish(), I.task->drones(),
+                                  I.task->max_pair_distance_m(), I.task->epsilon_m());
+      lock.unlock();
+      on_progress(p);
+      lock.lock();
+    }
+  }
+  I.outcome = o;
+  return o.line();
+}
+
+SwarmStatus DdsCommander::status() {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  SwarmStatus s;
+  s.drones_online = static_cast<int>(impl_->online_locked().size());
+  s.d_int_m = impl_->d_int_locked();
+  if (impl_->sim) {
+    const auto& m = *impl_->sim;
+    s.sim_time_s = m.sim_time_s();
+    s.real_time_factor = m.real_time_factor();
+    s.drones_total = m.num_drones();
+    s.airborne = m.airborne();
+    s.collisions = static_cast<int>(m.collisions_obstacle() + m.collisions_drone() + m.collisions_ground());
+    s.mode = (m.mode() == msg::MODE_LOCKSTEP ? "lockstep, " : "realtime, ") + m.state().to_string();
+  } else {
+    s.real_time_factor = std::nan("");
+    s.mode = "no server";
+  }
+  std::map<Phase, int> phases;
+  for (const auto& [id, a] : impl_->agents) phases[a.phase]++;
+  for (const auto& [p, k] : phases) s.task_phase += fmt::format("{}{} {}", s.task_phase.empty() ? "" : ", ", k, to_string(p));
+  return s;
+}
+
+std::optional<TaskOutcome> DdsCommander::last_task() const {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->outcome;
+}
+
+}  // namespace ddswarm::gs

@@ -1,0 +1,60 @@
+#pragma once
+// The ground station's link to the swarm over DDS: sends mission commands,
+// gathers every live agent's acknowledgement, follows status and the task.
+#include <memory>
+#include <optional>
+
+#include "common/dds_config.hpp"
+#include "ground_station/commander.hpp"
+#include "ground_station/gs_config.hpp"
+
+namespace ddswarm::gs {
+
+/// A finished (or failed) task as the server refereed it.
+struct TaskOutcome {
+  bool ok = false;
+  std::string reason;
+  double task_time_s = 0;    ///< s sim
+  double wall_time_s = 0;    ///< s wall
+  double epsilon_m = 0;
+  double speed_mps = 0;
+  int drones = 0;
+  int collisions_obstacle = 0, collisions_drone = 0, collisions_ground = 0;
+  double min_inter_drone_m = 0;
+  double min_clearance_m = 0;
+  std::string line() const;  ///< the one-line result
+};
+
+class DdsCommander final : public Commander {
+ public:
+  DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds);
+  ~DdsCommander() override;
+
+  /// Waits until the server is heard and count agents are online (count < 0:
+  /// as many as the server's scenario has). Returns false on timeout.
+  bool wait_for_swarm(int count, double timeout_s);
+  /// Waits until sim time reaches t (s). False on timeout (wall) or stop.
+  bool wait_sim_time(double t, double timeout_s);
+  /// Waits until `airborne` drones are airborne (or on the ground when 0).
+  bool wait_airborne(int count, double timeout_s);
+
+  CommandResult takeoff(double altitude_m) override;
+  CommandResult move(const Eigen::Vector3d& v_enu, double duration_s) override;
+  CommandResult set_distance(double d_int_m) override;
+  CommandResult land() override;
+  CommandResult follow_leader(int leader_id) override;
+  CommandResult teleop(const Eigen::Vector3d& v_enu) override;
+  CommandResult hold() override;
+  CommandResult task(double speed_mps, double epsilon_m) override;
+  std::string wait_task(std::function<void(const std::string&)> on_progress) override;
+  SwarmStatus status() override;
+
+  /// The last task's outcome, once wait_task() returned.
+  std::optional<TaskOutcome> last_task() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ddswarm::gs

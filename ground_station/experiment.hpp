@@ -1,0 +1,31 @@
+#pragma once
+// Runs the thesis task end to end, once (fly_task) or as an experiment of
+// repeated, seeded, real multi-process runs (run_experiment, thesis Table 1).
+#include <functional>
+#include <ostream>
+#include <string>
+
+#include "common/dds_config.hpp"
+#include "ground_station/dds_commander.hpp"
+#include "ground_station/experiment_config.hpp"
+#include "ground_station/gs_config.hpp"
+
+namespace ddswarm::gs {
+
+/// Waits for `drones` agents, takes off, waits until airborne, starts the
+/// task and waits for its result. Failures come back as an outcome with a reason.
+TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
+                     const std::function<void(const std::string&)>& progress);
+
+struct ExperimentOptions {
+  std::string out_dir = "results";  ///< CSV, table, plots, per-run scenarios and logs go here
+  DdsConfig dds;                    ///< domain and network of every run
+  GroundStationConfig gs;
+  std::string bin_dir;              ///< where ddswarm-sim / ddswarm-agent live (default: next to us)
+};
+
+/// Runs every set's runs in order; returns 0 when every run completed, 1 when
+/// some failed (they are recorded with their reason), throws on setup errors.
+int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, std::ostream& out);
+
+}  // namespace ddswarm::gs

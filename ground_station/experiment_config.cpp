@@ -1,0 +1,171 @@
+#include "ground_station/experiment_config.hpp"
+
+#include <filesystem>
+#include <set>
+#include <stdexcept>
+
+#include "common/config_error.hpp"
+
+namespace ddswarm::gs {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Splits "a.b.c" into its parts; returns an empty vector when a part is empty.
+std::vector<std::string> split_key(const std::string& key) {
+  std::vector<std::string> parts;
+  std::string::size_type start = 0;
+  for (;;) {
+    const auto dot = key.find('.', start);
+    parts.push_back(key.substr(start, dot - start));
+    if (parts.back().empty()) return {};
+    if (dot == std::string::npos) return parts;
+    start = dot + 1;
+  }
+}
+
+const char* kind(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Scalar:
+      return "a value";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    default:
+      return "empty";
+  }
+}
+
+}  // namespace
+
+void ExperimentConfig::validate() const {
+  if (name.empty()) throw FieldError("experiment.name", "\"\"", "must not be empty");
+  if (scenario.empty())
+    throw FieldError("experiment.scenario", "\"\"", "must name a scenario file");
+  check_range("experiment.runs_per_set", runs_per_set, 1, 1000);
+  if (mode != "lockstep" && mode != "realtime")
+    throw FieldError("experiment.mode", mode, "must be lockstep or realtime");
+  check_positive("experiment.timeout_s", timeout_s);
+  if (sets.empty()) throw FieldError("experiment.sets", "[]", "must list at least one set");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const std::string field = "experiment.sets[" + std::to_string(i) + "]";
+    const ExperimentSet& s = sets[i];
+    if (s.name.empty()) throw FieldError(field + ".name", "\"\"", "must not be empty");
+    if (!names.insert(s.name).second)
+      throw FieldError(field + ".name", s.name, "another set has this name");
+    for (const auto& [key, value] : s.overrides) {
+      if (split_key(key).empty())
+        throw FieldError(field + ".set." + key, key, "must be a dotted key path like agent.x");
+      // The map is sorted: keys extending "key." start at lower_bound("key.").
+      auto next = s.overrides.lower_bound(key + ".");
+      if (next != s.overrides.end() && next->first.compare(0, key.size() + 1, key + ".") == 0)
+        throw FieldError(field + ".set." + next->first, next->first,
+                         "conflicts with " + key + " (set one or the other)");
+    }
+  }
+}
+
+std::uint64_t ExperimentConfig::seed(int set_index, int run_index) const {
+  return base_seed + static_cast<std::uint64_t>(set_index) * 1000u +
+         static_cast<std::uint64_t>(run_index);
+}
+
+void load(YamlSection s, ExperimentConfig& c, const std::string& base_dir) {
+  s.get("name", c.name);
+  s.get("scenario", c.scenario);
+  s.get("runs_per_set", c.runs_per_set);
+  s.get("base_seed", c.base_seed);
+  s.get("mode", c.mode);
+  s.get("timeout_s", c.timeout_s);
+  c.sets.clear();
+  for (YamlSection set : s.children("sets")) {
+    ExperimentSet e;
+    set.get("name", e.name);
+    YamlSection overrides = set.child("set");
+    const YAML::Node& n = overrides.node();
+    if (n && n.IsMap()) {
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        const std::string key = it->first.Scalar();
+        if (!e.overrides.emplace(key, YAML::Clone(it->second)).second)
+          overrides.fail(it->first, key, YAML::Dump(it->second), "set twice");
+      }
+    }
+    set.finish();
+    c.sets.push_back(std::move(e));
+  }
+  s.finish();
+  if (!c.scenario.empty()) {
+    const fs::path p(c.scenario);
+    c.scenario_path =
+        p.is_absolute() ? p.string() : (fs::path(base_dir) / p).lexically_normal().string();
+  }
+}
+
+namespace {
+
+ExperimentConfig from_document(const YamlDocument& doc) {
+  YamlSection root(doc.root(), doc.file(), "");
+  ExperimentConfig c;
+  doc.guard([&] {
+    if (!root.has("experiment")) throw ConfigError(doc.file() + ":1: no `experiment:` section");
+    load(root.child("experiment"), c, fs::path(doc.file()).parent_path().string());
+    root.finish();
+    c.validate();
+  });
+  return c;
+}
+
+}  // namespace
+
+ExperimentConfig parse_experiment(const std::string& text, const std::string& file) {
+  return from_document(YamlDocument::parse(text, file));
+}
+
+ExperimentConfig load_experiment_file(const std::string& path) {
+  return from_document(YamlDocument::load_file(path));
+}
+
+YAML::Node apply_overrides(YAML::Node scenario,
+                           const std::map<std::string, YAML::Node>& overrides) {
+  YAML::Node out = YAML::Clone(scenario);
+  if (!out || out.IsNull()) out = YAML::Node(YAML::NodeType::Map);
+  for (const auto& [key, value] : overrides) {
+    const auto parts = split_key(key);
+    if (parts.empty())
+      throw ConfigError("override " + key + ": must be a dotted key path like agent.x");
+    if (!out.IsMap())
+      throw ConfigError("override " + key + ": the scenario is " + kind(out) + ", not a mapping");
+    // yaml-cpp: Node assignment writes through; reset() rebinds the handle.
+    YAML::Node cur;
+    cur.reset(out);
+    std::string walked;
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+      walked += (i ? "." : "") + parts[i];
+      YAML::Node next = cur[parts[i]];
+      if (!next || next.IsNull()) {
+        cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
+        next.reset(cur[parts[i]]);
+      } else if (!next.IsMap()) {
+        throw ConfigError("override " + key + ": " + walked + " is " + kind(next) +
+                          ", not a mapping");
+      }
+      cur.reset(next);
+    }
+    cur[parts.back()] = YAML::Clone(value);
+  }
+  return out;
+}
+
+YAML::Node scenario_for_set(const ExperimentConfig& c, std::size_t set_index) {
+  const ExperimentSet& set = c.sets.at(set_index);
+  const YamlDocument doc = YamlDocument::load_file(c.scenario_path);
+  try {
+    return apply_overrides(doc.root(), set.overrides);
+  } catch (const ConfigError& e) {
+    throw ConfigError(c.scenario_path + ": set '" + set.name + "': " + e.what());
+  }
+}
+
+}  // namespace ddswarm::gs

@@ -1,0 +1,77 @@
+#pragma once
+// Experiment files: a scenario run many times under several parameter sets,
+// like the thesis's Table 1 (config/table1.yaml).
+//
+//   experiment:
+//     name: table1
+//     scenario: thesis_course.yaml   # relative to the experiment file
+//     runs_per_set: 15
+//     base_seed: 1000
+//     mode: lockstep
+//     timeout_s: 300
+//     sets:
+//       - name: Sim 1
+//         set: { agent.inter_distance_m: 4, task.speed_mps: 0.8 }
+//
+// Each set's `set:` maps dotted key paths of the scenario YAML to values;
+// apply_overrides() writes them into a copy of the scenario, whose own loader
+// then checks them like any other scenario key.
+//
+// Seeds: run k (0-based) of set s (0-based, in file order) uses
+// base_seed + s * 1000 + k, so a run can be repeated alone and adding sets or
+// runs never changes the seeds of the others.
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/yaml_section.hpp"
+
+namespace ddswarm::gs {
+
+/// One parameter set: one column of the results table.
+struct ExperimentSet {
+  std::string name;                             ///< column title, e.g. "Sim 1"; unique, non-empty
+  std::map<std::string, YAML::Node> overrides;  ///< dotted scenario key -> value
+};
+
+struct ExperimentConfig {
+  std::string name = "experiment";  ///< used in output file names, non-empty
+  std::string scenario;             ///< scenario file as written
+  std::string scenario_path;        ///< scenario file resolved against the experiment's folder
+  int runs_per_set = 15;            ///< runs of each set, in [1, 1000]
+  std::uint64_t base_seed = 1000;   ///< seed of run 0 of set 0 (see seed())
+  std::string mode = "lockstep";    ///< simulation clock: lockstep | realtime
+  double timeout_s = 300;           ///< s of sim time before a run counts as failed, > 0
+  std::vector<ExperimentSet> sets;  ///< at least one
+
+  /// Throws FieldError("experiment.…") naming the first bad field.
+  void validate() const;
+
+  /// Seed of run run_index of set set_index: base_seed + set_index * 1000 + run_index.
+  std::uint64_t seed(int set_index, int run_index) const;
+};
+
+/// Reads the `experiment:` section (strict: unknown keys are an error).
+/// scenario_path is resolved against base_dir. Does not validate.
+void load(YamlSection s, ExperimentConfig& c, const std::string& base_dir);
+
+/// Loads and validates an experiment file. Throws ConfigError "file:line: …".
+ExperimentConfig load_experiment_file(const std::string& path);
+
+/// Same, from text; file names the text in errors and anchors the scenario path.
+ExperimentConfig parse_experiment(const std::string& text, const std::string& file);
+
+/// A deep copy of scenario with every override written in: key "a.b.c" sets
+/// scenario[a][b][c], creating missing mappings. Throws ConfigError naming the
+/// key when a path is malformed or walks through a value that is not a mapping.
+YAML::Node apply_overrides(YAML::Node scenario, const std::map<std::string, YAML::Node>& overrides);
+
+/// The scenario of set set_index: the scenario file with the set's overrides
+/// applied. Throws ConfigError (unreadable scenario, bad override) or
+/// std::out_of_range (set_index).
+YAML::Node scenario_for_set(const ExperimentConfig& c, std::size_t set_index);
+
+}  // namespace ddswarm::gs

@@ -1,0 +1,191 @@
+// ddswarm-launch: starts the server and one agent process per drone (and
+// optionally ground-station commands), prefixes their logs, supervises them.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "common/process.hpp"
+#include "ground_station/gs_app.hpp"
+#include "ground_station/launcher.hpp"
+
+using namespace ddswarm;
+using namespace ddswarm::gs;
+
+namespace {
+
+std::vector<std::string> split_script(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string part;
+  while (std::getline(ss, part, ';')) {
+    auto a = part.find_first_not_of(" \t");
+    if (a == std::string::npos) continue;
+    out.push_back(part.substr(a, part.find_last_not_of(" \t") - a + 1));
+  }
+  return out;
+}
+
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> w;
+  std::stringstream ss(s);
+  std::string x;
+  while (ss >> x) w.push_back(x);
+  return w;
+}
+
+/// Runs a child in the foreground with this terminal; returns its exit status.
+int run_foreground(const std::vector<std::string>& argv, Launcher& procs, bool stop_on_death,
+                   bool& died) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> a;
+    for (const auto& s : argv) a.push_back(const_cast<char*>(s.c_str()));
+    a.push_back(nullptr);
+    execv(a[0], a.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    for (const auto& e : procs.reap()) {
+      std::cerr << "ddswarm-launch: " << e.describe() << "\n";
+      died = true;
+      if (stop_on_death) kill(pid, SIGTERM);
+    }
+    if (stop_requested()) kill(pid, SIGINT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_main("ddswarm-launch", [&]() -> int {
+    CLI::App app{"ddswarm-launch: start the server and one agent process per drone"};
+    std::string scenario, only = "all", ids_text, on_death = "stop", gs_script, log_dir;
+    std::optional<int> drones;
+    std::optional<std::string> mode;
+    std::optional<std::uint64_t> seed;
+    double duration_s = 0;
+    bool gs_interactive = false;
+    DdsConfig dds_cli;
+    app.add_option("scenario", scenario, "scenario YAML")->required();
+    app.add_option("--drones", drones, "number of drones (overrides the scenario)");
+    app.add_option("--mode", mode, "lockstep | realtime")->check(CLI::IsMember({"lockstep", "realtime"}));
+    app.add_option("--seed", seed, "scenario seed");
+    app.add_option("--only", only, "start only: server | agents | all")->check(CLI::IsMember({"server", "agents", "all"}));
+    app.add_option("--ids", ids_text, "agents to start, e.g. 3-5,7 (default: all)");
+    app.add_option("--on-death", on_death,
+                   "when a process dies: stop (stop everything, exit 1) | keep (report, keep flying)")
+        ->check(CLI::IsMember({"stop", "keep"}));
+    app.add_option("--gs", gs_script,
+                   "ground-station commands to run once every agent is online, e.g. \"takeoff --wait; task\"; "
+                   "everything stops when they finish");
+    app.add_flag("--gs-interactive", gs_interactive, "open the ground-station console here");
+    app.add_option("--log-dir", log_dir, "write each process's log to DIR/<name>.log instead of the terminal");
+    app.add_option("--duration", duration_s, "stop everything after this many wall seconds");
+    add_dds_options(app, dds_cli);
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      return app.exit(e) == 0 ? 0 : 2;
+    }
+    auto file = load_gs_config(scenario);
+    const int n = drones.value_or(file.drones);
+    if (n < 1 || n > 1024) throw FieldError("--drones", std::to_string(n), "must be in [1, 1024]");
+    std::vector<int> ids;
+    if (only != "server") {
+      if (ids_text.empty())
+        for (int i = 0; i < n; ++i) ids.push_back(i);
+      else
+        try {
+          ids = parse_id_ranges(ids_text, n);
+        } catch (const std::invalid_argument& e) {
+          throw FieldError("--ids", ids_text, e.what());
+        }
+    }
+    // Flags every child shares: the domain and the network opt-ins, verbatim.
+    std::vector<std::string> dds_args;
+    for (const char* opt : {"--domain", "--dds-interface", "--dds-local-ip", "--discovery-server",
+                            "--dds-profiles", "--dds-peers"}) {
+      if (app.count(opt)) {
+        auto* o = app.get_option(opt);
+        dds_args.push_back(opt);
+        std::string v;
+        for (const auto& r : o->results()) v += (v.empty() ? "" : ",") + r;
+        dds_args.push_back(v);
+      }
+    }
+    const std::string bin = Launcher::self_dir();
+    install_stop_signals();
+    const bool stop_on_death = on_death == "stop";
+    Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
+    if (only != "agents") {
+      std::vector<std::string> a = {bin + "/ddswarm-sim", "--scenario", scenario, "--drones", std::to_string(n)};
+      if (mode) {
+        a.push_back("--mode");
+        a.push_back(*mode);
+      }
+      if (seed) {
+        a.push_back("--seed");
+        a.push_back(std::to_string(*seed));
+      }
+      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      procs.start({"sim", a});
+    }
+    for (int id : ids) {
+      std::vector<std::string> a = {bin + "/ddswarm-agent", "--id", std::to_string(id), "--config",
+                                    scenario, "--drones", std::to_string(n)};
+      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      procs.start({"agent " + std::to_string(id), a});
+    }
+    std::cerr << fmt::format("ddswarm-launch: started {} process(es); policy on death: {}\n",
+                             procs.running(), on_death);
+    int rc = 0;
+    bool died = false;
+    auto gs_argv = [&](const std::vector<std::string>& sub) {
+      std::vector<std::string> a = {bin + "/ddswarm-gs", "--config", scenario};
+      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      a.insert(a.end(), sub.begin(), sub.end());
+      return a;
+    };
+    if (!gs_script.empty()) {
+      std::vector<std::string> steps = {"wait-agents --count " + std::to_string(ids.empty() ? 0 : static_cast<int>(ids.size()))};
+      for (const auto& s : split_script(gs_script)) steps.push_back(s);
+      for (const auto& step : steps) {
+        if (stop_requested() || (died && stop_on_death)) break;
+        std::cerr << "ddswarm-launch: gs " << step << "\n";
+        rc = run_foreground(gs_argv(words(step)), procs, stop_on_death, died);
+        if (rc != 0) {
+          std::cerr << fmt::format("ddswarm-launch: 'ddswarm-gs {}' failed (exit {})\n", step, rc);
+          break;
+        }
+      }
+    } else if (gs_interactive) {
+      rc = run_foreground(gs_argv({"menu"}), procs, stop_on_death, died);
+    } else {
+      double end = duration_s > 0 ? wall_seconds() + duration_s : 1e300;
+      while (!stop_requested() && wall_seconds() < end && procs.running() > 0) {
+        for (const auto& e : procs.reap()) {
+          std::cerr << "ddswarm-launch: " << e.describe() << "\n";
+          died = true;
+        }
+        if (died && stop_on_death) break;
+        wait_for_stop(std::chrono::milliseconds(100));
+      }
+    }
+    if (died && stop_on_death) std::cerr << "ddswarm-launch: a process died; stopping everything\n";
+    for (const auto& e : procs.stop_all(3.0))
+      if (e.signal != 0 && e.signal != SIGTERM && e.signal != SIGINT)
+        std::cerr << "ddswarm-launch: at shutdown " << e.describe() << "\n";
+    std::cerr << "ddswarm-launch: all processes stopped\n";
+    if (rc != 0) return 1;
+    return died && stop_on_death ? 1 : 0;
+  });
+}

@@ -1,0 +1,263 @@
+#include "ground_station/launcher.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+namespace ddswarm::gs {
+
+std::string ChildExit::describe() const {
+  std::ostringstream os;
+  os << name << " (pid " << pid << ")";
+  if (signal) {
+    const char* s = sigabbrev_np(signal);
+    os << " was killed by SIG" << (s ? s : std::to_string(signal).c_str());
+  } else {
+    os << " exited with code " << exit_code;
+  }
+  return os.str();
+}
+
+Launcher::Launcher(std::string log_dir) : log_dir_(std::move(log_dir)) {
+  if (!log_dir_.empty()) std::filesystem::create_directories(log_dir_);
+  if (pipe2(wake_, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  pump_ = std::thread([this] { pump(); });
+}
+
+Launcher::~Launcher() {
+  stop_all();
+  quit_ = true;
+  char b = 0;
+  (void)!write(wake_[1], &b, 1);
+  if (pump_.joinable()) pump_.join();
+  close(wake_[0]);
+  close(wake_[1]);
+  for (auto& c : closed_)
+    if (c->log) fclose(c->log);
+}
+
+std::string Launcher::self_dir() {
+  std::error_code ec;
+  auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : p.parent_path().string();
+}
+
+pid_t Launcher::start(const ChildSpec& spec) {
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  if (access(spec.argv.at(0).c_str(), X_OK) != 0) {
+    close(fds[0]);
+    close(fds[1]);
+    throw std::runtime_error("cannot run " + spec.argv[0] + ": " + std::strerror(errno));
+  }
+  const pid_t parent = getpid();
+  pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed for " + spec.name);
+  if (pid == 0) {
+    // Child: die with the launcher, write into the pipe, run the program.
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);
+    setpgid(0, 0);  // Ctrl-C reaches the launcher, which stops children in order
+    dup2(fds[1], STDOUT_FILENO);
+    dup2(fds[1], STDERR_FILENO);
+    std::vector<char*> argv;
+    for (const auto& a : spec.argv) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    std::fprintf(stderr, "cannot exec %s: %s\n", argv[0], std::strerror(errno));
+    _exit(127);
+  }
+  close(fds[1]);
+  auto c = std::make_unique<Child>();
+  c->name = spec.name;
+  c->pid = pid;
+  c->out_fd = fds[0];
+  if (!log_dir_.empty()) {
+    std::string file = spec.name;
+    for (auto& ch : file)
+      if (ch == ' ' || ch == '/') ch = '_';
+    c->log = fopen((log_dir_ + "/" + file + ".log").c_str(), "w");
+  }
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    live_[pid] = std::move(c);
+  }
+  char b = 0;
+  (void)!write(wake_[1], &b, 1);
+  return pid;
+}
+
+void Launcher::emit(Child& c, const char* data, std::size_t n, bool flush) {
+  c.partial.append(data, n);
+  std::size_t start = 0, nl;
+  while ((nl = c.partial.find('\n', start)) != std::string::npos || (flush && start < c.partial.size())) {
+    std::size_t end = nl == std::string::npos ? c.partial.size() : nl;
+    std::string line = c.partial.substr(start, end - start);
+    if (c.log) {
+      fprintf(c.log, "%s\n", line.c_str());
+      fflush(c.log);
+    } else {
+      std::string out = "[" + c.name + "] " + line + "\n";
+      fwrite(out.data(), 1, out.size(), stdout);
+      fflush(stdout);
+    }
+    start = end + 1;
+    if (nl == std::string::npos) break;
+  }
+  c.partial.erase(0, std::min(start, c.partial.size()));
+}
+
+void Launcher::pump() {
+  std::vector<pollfd> fds;
+  std::vector<Child*> owners;
+  char buf[8192];
+  while (!quit_) {
+    fds.clear();
+    owners.clear();
+    fds.push_back({wake_[0], POLLIN, 0});
+    owners.push_back(nullptr);
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      for (auto& [pid, c] : live_)
+        if (c->out_fd >= 0) {
+          fds.push_back({c->out_fd, POLLIN, 0});
+          owners.push_back(c.get());
+        }
+    }
+    if (poll(fds.data(), fds.size(), 200) <= 0) continue;
+    if (fds[0].revents) (void)!read(wake_[0], buf, sizeof buf);
+    for (std::size_t i = 1; i < fds.size(); ++i) {
+      if (!fds[i].revents) continue;
+      ssize_t n = read(fds[i].fd, buf, sizeof buf);
+      std::lock_guard<std::mutex> lock(mu_);
+      Child* c = owners[i];
+      if (n > 0) {
+        emit(*c, buf, static_cast<std::size_t>(n), false);
+      } else {
+        emit(*c, "", 0, true);
+        close(c->out_fd);
+        c->out_fd = -1;
+      }
+    }
+  }
+}
+
+std::vector<ChildExit> Launcher::reap() {
+  std::vector<ChildExit> out;
+  std::lock_guard<std::mutex> lock(mu_);
+  for (auto it = live_.begin(); it != live_.end();) {
+    int status = 0;
+    pid_t r = waitpid(it->first, &status, WNOHANG);
+    if (r == it->first) {
+      ChildExit e;
+      e.name = it->second->name;
+      e.pid = r;
+      if (WIFEXITED(status)) e.exit_code = WEXITSTATUS(status);
+      if (WIFSIGNALED(status)) e.signal = WTERMSIG(status);
+      out.push_back(e);
+      // Drain what the child wrote before it died.
+      if (it->second->out_fd >= 0) {
+        char buf[8192];
+        int flags = fcntl(it->second->out_fd, F_GETFL);
+        fcntl(it->second->out_fd, F_SETFL, flags | O_NONBLOCK);
+        ssize_t n;
+        while ((n = read(it->second->out_fd, buf, sizeof buf)) > 0) emit(*it->second, buf, n, false);
+        emit(*it->second, "", 0, true);
+        close(it->second->out_fd);
+        it->second->out_fd = -1;
+      }
+      closed_.push_back(std::move(it->second));
+      it = live_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  return out;
+}
+
+int Launcher::running() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return static_cast<int>(live_.size());
+}
+
+std::vector<std::pair<std::string, pid_t>> Launcher::children() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  std::vector<std::pair<std::string, pid_t>> out;
+  for (const auto& [pid, c] : live_) out.emplace_back(c->name, pid);
+  return out;
+}
+
+bool Launcher::signal(const std::string& name, int sig) {
+  std::lock_guard<std::mutex> lock(mu_);
+  for (const auto& [pid, c] : live_)
+    if (c->name == name) return kill(pid, sig) == 0;
+  return false;
+}
+
+std::vector<ChildExit> Launcher::stop_all(double grace_s) {
+  std::vector<ChildExit> out;
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (const auto& [pid, c] : live_) kill(pid, SIGTERM);
+  }
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);
+  while (running() > 0 && std::chrono::steady_clock::now() < deadline) {
+    for (auto& e : reap()) out.push_back(e);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (const auto& [pid, c] : live_) kill(pid, SIGKILL);
+  }
+  while (running() > 0) {
+    for (auto& e : reap()) out.push_back(e);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return out;
+}
+
+std::vector<int> parse_id_ranges(const std::string& text, int max_exclusive) {
+  std::vector<int> ids;
+  std::stringstream ss(text);
+  std::string part;
+  auto bad = [&](const std::string& why) {
+    throw std::invalid_argument("--ids " + text + ": " + why);
+  };
+  while (std::getline(ss, part, ',')) {
+    if (part.empty()) bad("empty range");
+    auto dash = part.find('-');
+    try {
+      std::size_t used = 0;
+      int a = std::stoi(part.substr(0, dash), &used);
+      if (used != (dash == std::string::npos ? part.size() : dash)) bad("not a number: " + part);
+      int b = a;
+      if (dash != std::string::npos) {
+        b = std::stoi(part.substr(dash + 1), &used);
+        if (used != part.size() - dash - 1) bad("not a number: " + part);
+      }
+      if (a > b) bad("range " + part + " runs backwards");
+      if (a < 0 || b >= max_exclusive)
+        bad("ids must be in [0, " + std::to_string(max_exclusive - 1) + "]");
+      for (int i = a; i <= b; ++i) ids.push_back(i);
+    } catch (const std::invalid_argument& e) {
+      if (std::string(e.what()).rfind("--ids", 0) == 0) throw;
+      bad("not a number: " + part);
+    } catch (const std::out_of_range&) {
+      bad("number too large: " + part);
+    }
+  }
+  if (ids.empty()) bad("no ids");
+  return ids;
+}
+
+}  // namespace ddswarm::gs

@@ -1,0 +1,77 @@
+#pragma once
+// Starts and supervises ddswarm processes: prefixes and collects their logs,
+// says which one died and why, and tears everything down cleanly.
+#include <sys/types.h>
+
+#include <atomic>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace ddswarm::gs {
+
+struct ChildSpec {
+  std::string name;               ///< log prefix, e.g. "sim", "agent 3"
+  std::vector<std::string> argv;  ///< argv[0] is the executable path
+};
+
+struct ChildExit {
+  std::string name;
+  pid_t pid = 0;
+  int exit_code = -1;   ///< when it exited
+  int signal = 0;       ///< when a signal killed it
+  std::string describe() const;  ///< "agent 3 (pid 1234) exited with code 1" / "was killed by SIGKILL"
+};
+
+class Launcher {
+ public:
+  /// log_dir: when set, each child's output goes to <log_dir>/<name>.log
+  /// instead of this process's stdout (prefixed there otherwise).
+  explicit Launcher(std::string log_dir = "");
+  ~Launcher();  ///< stops every child still running
+  Launcher(const Launcher&) = delete;
+  Launcher& operator=(const Launcher&) = delete;
+
+  /// Forks and execs; throws std::runtime_error naming the program on failure.
+  pid_t start(const ChildSpec& spec);
+  /// Children that ended since the last call (never blocks).
+  std::vector<ChildExit> reap();
+  int running() const;
+  /// SIGTERM to every child, SIGKILL after grace_s; waits for all of them.
+  /// Returns the exits it collected.
+  std::vector<ChildExit> stop_all(double grace_s = 3.0);
+  /// Sends sig to one child by name (tests, fault injection).
+  bool signal(const std::string& name, int sig);
+  std::vector<std::pair<std::string, pid_t>> children() const;
+
+  /// Directory of the running executable (where the sibling binaries live).
+  static std::string self_dir();
+
+ private:
+  struct Child {
+    std::string name;
+    pid_t pid;
+    int out_fd;
+    std::string partial;
+    FILE* log = nullptr;
+  };
+  void pump();
+  void emit(Child& c, const char* data, std::size_t n, bool flush);
+
+  std::string log_dir_;
+  mutable std::mutex mu_;
+  std::map<pid_t, std::unique_ptr<Child>> live_;
+  std::vector<std::unique_ptr<Child>> closed_;
+  std::atomic<bool> quit_{false};
+  int wake_[2] = {-1, -1};
+  std::thread pump_;
+};
+
+/// Parses "3-5,7" into {3,4,5,7}; throws std::invalid_argument naming the text.
+std::vector<int> parse_id_ranges(const std::string& text, int max_exclusive);
+
+}  // namespace ddswarm::gs

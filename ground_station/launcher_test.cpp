@@ -1,0 +1,64 @@
+#include "ground_station/launcher.hpp"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <thread>
+
+using namespace ddswarm::gs;
+
+TEST(Launcher, ReportsWhichChildDiedAndWhy) {
+  Launcher l(::testing::TempDir() + "/launcher_logs");
+  l.start({"quitter", {"/bin/sh", "-c", "echo bye; exit 3"}});
+  pid_t sleeper = l.start({"sleeper", {"/bin/sleep", "30"}});
+  std::vector<ChildExit> exits;
+  for (int i = 0; i < 100 && exits.empty(); ++i) {
+    exits = l.reap();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(exits.size(), 1u);
+  EXPECT_EQ(exits[0].describe().substr(0, 8), "quitter ");
+  EXPECT_EQ(exits[0].exit_code, 3);
+  ASSERT_TRUE(l.signal("sleeper", SIGKILL));
+  exits.clear();
+  for (int i = 0; i < 100 && exits.empty(); ++i) {
+    exits = l.reap();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(exits.size(), 1u);
+  EXPECT_EQ(exits[0].pid, sleeper);
+  EXPECT_NE(exits[0].describe().find("killed by SIGKILL"), std::string::npos);
+}
+
+TEST(Launcher, StopAllLeavesNoChildBehind) {
+  std::vector<pid_t> pids;
+  {
+    Launcher l;
+    for (int i = 0; i < 4; ++i) pids.push_back(l.start({"s" + std::to_string(i), {"/bin/sleep", "30"}}));
+    // One child ignores SIGTERM: stop_all must still end it.
+    pids.push_back(l.start({"stubborn", {"/bin/sh", "-c", "trap '' TERM; sleep 30"}}));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    auto exits = l.stop_all(0.5);
+    EXPECT_EQ(exits.size(), 5u);
+    EXPECT_EQ(l.running(), 0);
+  }
+  for (pid_t p : pids) EXPECT_NE(kill(p, 0), 0) << "pid " << p << " survived";
+}
+
+TEST(Launcher, IdRanges) {
+  EXPECT_EQ(parse_id_ranges("3-5,7", 10), (std::vector<int>{3, 4, 5, 7}));
+  EXPECT_THROW(parse_id_ranges("5-3", 10), std::invalid_argument);
+  EXPECT_THROW(parse_id_ranges("1-12", 10), std::invalid_argument);
+  EXPECT_THROW(parse_id_ranges("x", 10), std::invalid_argument);
+}
+
+TEST(Launcher, MissingProgramIsAClearError) {
+  Launcher l;
+  try {
+    l.start({"ghost", {"/no/such/program"}});
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/no/such/program"), std::string::npos);
+  }
+}

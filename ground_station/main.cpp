@@ -1,0 +1,204 @@
+// ddswarm-gs: the ground station. Without a subcommand it opens the
+// interactive console (thesis Fig. 9); subcommands script the same actions.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <iostream>
+
+#include "common/process.hpp"
+#include "ground_station/dds_commander.hpp"
+#include "ground_station/experiment.hpp"
+#include "ground_station/gs_app.hpp"
+#include "ground_station/line_reader.hpp"
+#include "ground_station/menu.hpp"
+#include "ground_station/report.hpp"
+
+using namespace ddswarm;
+using namespace ddswarm::gs;
+
+namespace {
+
+int report(const CommandResult& r) {
+  std::printf("%s\n", r.message.c_str());
+  return r.ok ? 0 : 1;
+}
+
+void append_result(const std::string& csv, const TaskOutcome& o, int drones) {
+  if (csv.empty()) return;
+  RunRecord rec;
+  rec.set_name = "cli";
+  rec.drones = drones;
+  rec.speed_mps = o.speed_mps;
+  rec.ok = o.ok;
+  rec.failure_reason = o.reason;
+  rec.task_time_s = o.ok ? o.task_time_s : std::nan("");
+  rec.wall_time_s = o.wall_time_s;
+  rec.collisions_obstacle = o.collisions_obstacle;
+  rec.collisions_drone = o.collisions_drone;
+  rec.collisions_ground = o.collisions_ground;
+  rec.min_inter_drone_m = o.min_inter_drone_m;
+  rec.min_clearance_m = o.min_clearance_m;
+  append_csv(csv, rec);
+}
+
+bool finite_all(std::initializer_list<double> v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_main("ddswarm-gs", [&]() -> int {
+    CLI::App app{"ddswarm-gs: the ground station (console, scripted commands, experiments)"};
+    app.require_subcommand(0, 1);
+    std::string config;
+    DdsConfig dds_cli;
+    app.add_option("--config", config, "scenario YAML (ground_station, task and dds sections)");
+    add_dds_options(app, dds_cli);
+
+    auto* menu = app.add_subcommand("menu", "interactive console (the default)");
+    auto* wait_agents = app.add_subcommand("wait-agents", "wait until the server and N agents are online");
+    int wait_count = -1;
+    double wait_timeout = 30;
+    wait_agents->add_option("--count", wait_count, "agents to wait for (default: all drones)");
+    wait_agents->add_option("--timeout", wait_timeout, "seconds");
+    auto* takeoff = app.add_subcommand("takeoff", "take off and hold");
+    double altitude = 0;
+    bool wait_flag = false;
+    takeoff->add_option("--altitude", altitude, "m above ground (0 = agents' default)")->check(CLI::Range(0.0, 1000.0));
+    takeoff->add_flag("--wait", wait_flag, "wait until every drone is airborne");
+    auto* move = app.add_subcommand("move", "move the swarm by velocity for a time");
+    double north = 0, east = 0, up = 0, time_s = 0;
+    move->add_option("--north", north, "m/s")->check(CLI::Range(-50.0, 50.0));
+    move->add_option("--east", east, "m/s")->check(CLI::Range(-50.0, 50.0));
+    move->add_option("--up", up, "m/s")->check(CLI::Range(-50.0, 50.0));
+    move->add_option("--time", time_s, "s")->required()->check(CLI::Range(0.0, 86400.0));
+    move->add_flag("--wait", wait_flag, "wait until the move's time has passed (sim time)");
+    auto* distance = app.add_subcommand("distance", "change the inter-drone distance D_int");
+    double d_int = 0;
+    distance->add_option("metres", d_int, "new D_int (m)")->required()->check(CLI::Range(0.31, 1000.0));
+    auto* land = app.add_subcommand("land", "land every drone");
+    land->add_flag("--wait", wait_flag, "wait until every drone is on the ground");
+    auto* hold = app.add_subcommand("hold", "stop mission motion, keep swarming");
+    auto* follow = app.add_subcommand("follow", "follow the leader: the rest swarm around it");
+    int leader = 0;
+    follow->add_option("--leader", leader, "leader drone id")->required()->check(CLI::Range(0, 1023));
+    auto* teleop = app.add_subcommand("teleop", "set the leader's velocity while following");
+    teleop->add_option("--north", north, "m/s")->check(CLI::Range(-50.0, 50.0));
+    teleop->add_option("--east", east, "m/s")->check(CLI::Range(-50.0, 50.0));
+    teleop->add_option("--up", up, "m/s")->check(CLI::Range(-50.0, 50.0));
+    auto* task = app.add_subcommand("task", "run the thesis task (the swarm must be airborne)");
+    double speed = 0, epsilon = 0;
+    bool no_wait = false, fly = false;
+    std::string csv;
+    task->add_option("--speed", speed, "m/s toward the goal (default: task.speed_mps)")->check(CLI::Range(0.0, 50.0));
+    task->add_option("--epsilon", epsilon, "m, swarm condition (default: 2*D_int+1)")->check(CLI::Range(0.0, 10000.0));
+    task->add_flag("--no-wait", no_wait, "return once accepted");
+    task->add_flag("--takeoff", fly, "wait for every agent, take off first, then run the task");
+    task->add_option("--csv", csv, "append the result to this CSV");
+    auto* status = app.add_subcommand("status", "print the swarm's status");
+    auto* experiment = app.add_subcommand("experiment", "run an experiment file (e.g. config/table1.yaml)");
+    std::string exp_file, out_dir = "results";
+    experiment->add_option("file", exp_file, "experiment YAML")->required();
+    experiment->add_option("--out", out_dir, "output directory");
+
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      return app.exit(e) == 0 ? 0 : 2;
+    }
+    spdlog::set_level(spdlog::level::warn);
+    auto file = load_gs_config(config);
+    merge_cli(file.dds, dds_cli, app);
+    file.dds.validate();
+    install_stop_signals();
+
+    if (*experiment) {
+      auto exp = load_experiment_file(exp_file);
+      ExperimentOptions opt;
+      opt.out_dir = out_dir;
+      opt.dds = file.dds;
+      opt.gs = file.gs;
+      return run_experiment(exp, opt, std::cout);
+    }
+
+    DdsCommander gs(file.gs, file.dds);
+    const bool interactive = app.get_subcommands().empty() || *menu;
+    // Give discovery a moment: the server's status is transient-local.
+    if (!gs.wait_for_swarm(interactive || *status ? 0 : 1, file.gs.discovery_timeout_s) &&
+        !interactive) {
+      std::fprintf(stderr, "ddswarm-gs: error: no simulation server or agent found on domain %d within %.0f s\n",
+                   file.dds.domain_id, file.gs.discovery_timeout_s);
+      return 1;
+    }
+    if (interactive) {
+      LineReader reader(std::cin);
+      reader.set_interrupt(stop_requested);
+      MenuOptions mo;
+      mo.max_speed_mps = file.gs.max_input_speed_mps;
+      mo.max_duration_s = file.gs.max_input_time_s;
+      mo.default_task_speed_mps = file.task.speed_mps;
+      mo.task_epsilon_m = file.task.epsilon_m;
+      return run_menu(gs, reader, std::cout, mo);
+    }
+    if (*wait_agents) {
+      bool ok = gs.wait_for_swarm(wait_count, wait_timeout);
+      auto st = gs.status();
+      std::printf("%d/%d agents online\n", st.drones_online, st.drones_total);
+      return ok ? 0 : 1;
+    }
+    if (*status) {
+      std::printf("%s\n", format_status(gs.status()).c_str());
+      return 0;
+    }
+    if (*takeoff) {
+      int rc = report(gs.takeoff(altitude));
+      if (rc == 0 && wait_flag && !gs.wait_airborne(gs.status().drones_total, 120)) {
+        std::fprintf(stderr, "ddswarm-gs: error: not every drone became airborne within 120 s\n");
+        return 1;
+      }
+      return rc;
+    }
+    if (*move) {
+      if (!finite_all({north, east, up, time_s})) return 2;
+      double t0 = gs.status().sim_time_s;
+      int rc = report(gs.move(Eigen::Vector3d(east, north, up), time_s));
+      if (rc == 0 && wait_flag) gs.wait_sim_time(t0 + time_s, time_s * 100 + 60);
+      return rc;
+    }
+    if (*distance) return report(gs.set_distance(d_int));
+    if (*land) {
+      int rc = report(gs.land());
+      if (rc == 0 && wait_flag && !gs.wait_airborne(0, 120)) return 1;
+      return rc;
+    }
+    if (*hold) return report(gs.hold());
+    if (*follow) return report(gs.follow_leader(leader));
+    if (*teleop) return report(gs.teleop(Eigen::Vector3d(east, north, up)));
+    if (*task) {
+      TaskConfig t = file.task;
+      if (speed > 0) t.speed_mps = speed;
+      if (epsilon > 0) t.epsilon_m = epsilon;
+      auto progress = [](const std::string& p) { std::printf("  %s\n", p.c_str()); std::fflush(stdout); };
+      TaskOutcome o;
+      if (fly) {
+        o = fly_task(gs, file.drones, t, progress);
+      } else {
+        auto r = gs.task(t.speed_mps, t.epsilon_m);
+        std::printf("%s\n", r.message.c_str());
+        if (!r.ok) return 1;
+        if (no_wait) return 0;
+        gs.wait_task(progress);
+        o = gs.last_task().value_or(TaskOutcome{});
+      }
+      std::printf("%s\n", o.line().c_str());
+      append_result(csv.empty() ? file.gs.results_csv : csv, o, file.drones);
+      return o.ok ? 0 : 1;
+    }
+    return 0;
+  });
+}

@@ -1,0 +1,97 @@
+#pragma once
+// Experiment results: one CSV row per run, summaries per parameter set, the
+// thesis's Table 1 as Markdown and its Fig. 13-16 (task time per run) as
+// gnuplot plots. No DDS here: the runner fills RunRecords, this writes them.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace ddswarm::gs {
+
+/// One simulated run of one parameter set.
+struct RunRecord {
+  std::string set_name;          ///< e.g. "Sim 1"
+  int run_index = 0;             ///< 0-based index within the set
+  std::uint64_t seed = 0;        ///< scenario seed used for this run
+  int drones = 0;                ///< number of drones
+  double d_int_m = 0;            ///< m, wanted inter-drone distance D_int
+  double speed_mps = 0;          ///< m/s, wanted task speed
+  std::string sensor_function;   ///< e.g. "fs1"
+  std::string mode;              ///< e.g. "lockstep"
+  bool ok = false;               ///< the task completed within the time limit
+  std::string failure_reason;    ///< empty when ok
+  double task_time_s = 0;        ///< s of sim time from task start to swarm condition (NaN: none)
+  double wall_time_s = 0;        ///< s of wall-clock time the run took
+  int collisions_obstacle = 0;   ///< drone-obstacle collisions during the run
+  int collisions_drone = 0;      ///< drone-drone collisions (each pair counted once)
+  int collisions_ground = 0;     ///< unplanned ground contacts
+  double min_inter_drone_m = 0;  ///< m, smallest distance between two drones (inf: none)
+  double min_clearance_m = 0;    ///< m, smallest drone-obstacle clearance (inf: none)
+  std::map<std::string, std::string> params;  ///< other settings worth keeping (overrides)
+
+  int collisions() const { return collisions_obstacle + collisions_drone + collisions_ground; }
+};
+
+/// Appends one row to the CSV file at path, writing the header first when the
+/// file is new or empty. The row reaches the disk (written with one append,
+/// flushed, fsync'd) before this returns; concurrent appenders are serialised
+/// by a file lock. Throws std::runtime_error naming path when the file cannot
+/// be written or its header is not this version's.
+/// Format: RFC 4180 (fields with , " CR LF or edge spaces are quoted, quotes
+/// doubled); numbers in shortest round-trip form ("nan", "inf" allowed);
+/// ok as 1/0; params as key=value pairs joined by ';' with '\' escaping '\', ';', '='.
+void append_csv(const std::string& path, const RunRecord& record);
+
+/// Reads every row written by append_csv. Columns are found by header name
+/// (extra columns are ignored). Throws std::runtime_error "path:line: reason"
+/// on a missing file, missing column or malformed value.
+std::vector<RunRecord> read_csv(const std::string& path);
+
+/// Statistics of one parameter set (one column of Table 1).
+struct SetSummary {
+  std::string name;
+  int drones = 0;               ///< from the set's first run
+  double d_int_m = 0;           ///< m, from the set's first run
+  double speed_mps = 0;         ///< m/s, from the set's first run
+  std::string sensor_function;  ///< from the set's first run
+  std::string mode;             ///< from the set's first run
+  int runs = 0;                 ///< runs recorded
+  int failures = 0;             ///< runs with ok == false
+  double mean_time_s = 0;       ///< s, mean task time of successful runs (NaN: none)
+  double stddev_time_s = 0;     ///< s, sample standard deviation (n-1) of the same (NaN: < 2)
+  double min_time_s = 0;        ///< s, over successful runs (NaN: none)
+  double max_time_s = 0;        ///< s, over successful runs (NaN: none)
+  double mean_collisions = 0;   ///< all collisions per run, over every run
+  double mean_collisions_obstacle = 0;
+  double mean_collisions_drone = 0;
+  double mean_collisions_ground = 0;
+  double min_inter_drone_m = 0;  ///< m, smallest over every run (inf: none recorded)
+  double min_clearance_m = 0;    ///< m, smallest over every run (inf: none recorded)
+  double mean_wall_time_s = 0;   ///< s, mean wall-clock time per run
+  bool consistent = true;        ///< false when runs disagree on drones/D_int/speed/sensor/mode
+};
+
+/// One summary per set name, in the order sets first appear in records.
+std::vector<SetSummary> summarize(const std::vector<RunRecord>& records);
+
+/// Table 1 of the thesis as a Markdown table: one column per set (its name as
+/// header), rows Drones nr, Inter-distance, Velocity, Sensor Function,
+/// Avg. task time, Standard deviation, Avg. collisions, Min. inter-drone
+/// distance, Failures ("failures/runs"). Missing statistics print as "n/a".
+std::string markdown_table(const std::vector<SetSummary>& sets);
+
+/// File stem used for a set's plot files: lowercase letters, digits and '_'
+/// (e.g. "Sim 1" -> "sim_1"); never empty.
+std::string plot_stem(const std::string& set_name);
+
+/// For each set: out_dir/<stem>.dat (run, task time, collisions, ok),
+/// <stem>.gp (the gnuplot script) and the plot of task time per run, like the
+/// thesis's Fig. 13-16, as <stem>.png (pngcairo, or png without cairo) and
+/// <stem>.svg. Creates out_dir. Stems that collide get a numeric suffix.
+/// Returns the png paths. Throws std::runtime_error when gnuplot is missing or
+/// fails (with its message), or a file cannot be written.
+std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
+                                     const std::string& out_dir);
+
+}  // namespace ddswarm::gs

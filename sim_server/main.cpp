@@ -1,0 +1,41 @@
+// ddswarm-sim: the simulation server.
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include <optional>
+
+#include "common/process.hpp"
+#include "sim_server/sim_server.hpp"
+
+int main(int argc, char** argv) {
+  return ddswarm::run_main("ddswarm-sim", [&] {
+    CLI::App app{"ddswarm-sim: steps every quadrotor in Bullet and serves the swarm over DDS"};
+    std::string scenario;
+    double duration_s = 0;
+    std::optional<std::uint64_t> seed;
+    std::optional<int> drones;
+    std::optional<std::string> mode;
+    ddswarm::DdsConfig dds_cli;
+    app.add_option("--scenario,scenario", scenario, "scenario YAML")->required();
+    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = run until Ctrl-C)");
+    app.add_option("--seed", seed, "override scenario.seed");
+    app.add_option("--drones", drones, "override scenario.drones");
+    app.add_option("--mode", mode, "override scenario.mode")->check(CLI::IsMember({"realtime", "lockstep"}));
+    ddswarm::add_dds_options(app, dds_cli);
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      return app.exit(e) == 0 ? 0 : 2;
+    }
+    auto cfg = ddswarm::sim::load_server_config(scenario);
+    if (seed) cfg.scenario.seed = *seed;
+    if (drones) cfg.scenario.drones = *drones;
+    if (mode) cfg.scenario.mode = *mode == "lockstep" ? ddswarm::TimeMode::kLockstep : ddswarm::TimeMode::kRealtime;
+    ddswarm::merge_cli(cfg.dds, dds_cli, app);
+    cfg.validate();
+    ddswarm::install_stop_signals();
+    ddswarm::sim::SimServer server(std::move(cfg));
+    server.run(duration_s);
+    return 0;
+  });
+}

@@ -1,0 +1,28 @@
+#pragma once
+// The `sim:` section: clocks, time mode behaviour, failsafes, limits.
+#include "common/yaml_section.hpp"
+
+namespace ddswarm::sim {
+
+struct SimConfig {
+  double physics_rate_hz = 1000;        ///< Hz, fixed physics step rate; a multiple of control_rate_hz
+  double control_rate_hz = 50;          ///< Hz, state publish / command rate (one tick)
+  double sensor_rate_hz = 50;           ///< Hz, distance-sensor rate; divides control_rate_hz
+  double command_timeout_s = 0.5;       ///< s sim time: a drone without a fresh command hovers (failsafe)
+  double failsafe_land_after_s = 5.0;   ///< s in failsafe before the drone lands by itself
+  double agent_timeout_s = 1.0;         ///< s wall time: an agent silent this long is lost
+  double max_command_speed_mps = 50.0;  ///< m/s: commands above are absurd and rejected (within: clamped)
+  bool pause_when_idle = true;          ///< lockstep: hold the clock while every agent is idle
+  double status_rate_hz = 2.0;          ///< Hz wall, SimStatus publishing
+  bool publish_per_drone_topics = true; ///< also publish keyed DroneState/DistanceScan
+  double task_timeout_s = 600.0;        ///< s sim time before a running task fails
+  double airborne_height_m = 0.3;       ///< m above ground: counts as airborne
+
+  int substeps() const { return static_cast<int>(physics_rate_hz / control_rate_hz + 0.5); }
+  int sensor_every() const { return static_cast<int>(control_rate_hz / sensor_rate_hz + 0.5); }
+  void validate() const;
+};
+
+void load(YamlSection s, SimConfig& c);
+
+}  // namespace ddswarm::sim

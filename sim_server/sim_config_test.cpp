@@ -1,0 +1,49 @@
+#include "sim_server/sim_server.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+using namespace ddswarm;
+using namespace ddswarm::sim;
+
+namespace {
+std::string error_for(const std::string& yaml) {
+  const std::string path = ::testing::TempDir() + "/scenario_under_test.yaml";
+  std::ofstream(path) << yaml;
+  try {
+    load_server_config(path);
+  } catch (const ConfigError& e) {
+    std::string m = e.what();
+    return m.substr(m.find(':') + 1);  // drop the temp path
+  }
+  return "";
+}
+}  // namespace
+
+TEST(ServerConfig, TheShippedScenarioLoads) {
+  auto c = load_server_config(std::string(DDSWARM_CONFIG_DIR) + "/thesis_course.yaml");
+  EXPECT_EQ(c.scenario.drones, 6);
+  EXPECT_EQ(c.sim.substeps(), 20);
+  EXPECT_GE(c.scene.cylinders.size(), 10u);
+}
+
+TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
+  EXPECT_EQ(error_for("scenario:\n  drones: 0\n"), "2: scenario.drones = 0: must be in [1, 1024]");
+  EXPECT_EQ(error_for("sim:\n  physics_rate_hz: 1000\n  control_rate_hz: 30\n"),
+            "3: sim.control_rate_hz = 30: must divide physics_rate_hz (1000)");
+  EXPECT_EQ(error_for("scene:\n  cylinders:\n    - {center_xy: [5, 5], radius_m: -2}\n"),
+            "3: scene.cylinders[0].radius_m = -2: must be > 0");
+  EXPECT_EQ(error_for("sim:\n  colour: red\n"), "2: sim.colour: unknown key");
+  EXPECT_EQ(error_for("wings: 2\n"), "1: wings: unknown section");
+  EXPECT_EQ(error_for("sensors:\n  count: many\n"), "2: sensors.count = many: must be an integer");
+}
+
+TEST(ServerConfig, MissingFileIsAClearError) {
+  try {
+    load_server_config("/no/such/scenario.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), "/no/such/scenario.yaml: cannot open file");
+  }
+}

@@ -1,0 +1,647 @@
+#include "sim_server/sim_server.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <random>
+#include <set>
+#include <thread>
+
+#include "common/convert.hpp"
+#include "common/mission.hpp"
+#include "common/participant.hpp"
+#include "common/process.hpp"
+#include "sim_server/command_gate.hpp"
+#include "sim_server/task_referee.hpp"
+
+namespace ddswarm::sim {
+
+void ServerConfig::validate() const {
+  scenario.validate();
+  sim.validate();
+  quadrotor.validate();
+  controller.validate();
+  sensors.validate();
+  scene.validate();
+  dds.validate();
+  (void)scene.start_positions(scenario.drones, scenario.seed);
+}
+
+ServerConfig load_server_config(const std::string& path) {
+  auto doc = YamlDocument::load_file(path);
+  check_sections(doc);
+  ServerConfig c;
+  doc.guard([&] {
+    load(doc.section("scenario"), c.scenario);
+    load(doc.section("sim"), c.sim);
+    load(doc.section("quadrotor"), c.quadrotor);
+    load(doc.section("controller"), c.controller);
+    load(doc.section("sensors"), c.sensors);
+    load(doc.section("scene"), c.scene);
+    load(doc.section("dds"), c.dds);
+    c.validate();
+  });
+  return c;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool flying_phase(Phase p) {
+  return p == Phase::kHold || p == Phase::kMove || p == Phase::kTask || p == Phase::kSwarm ||
+         p == Phase::kFollow;
+}
+
+/// What the server knows about one drone's agent and its last command.
+struct Slot {
+  VelocitySetpoint setpoint;   // last accepted command
+  bool has_command = false;
+  std::uint64_t command_tick = 0;
+  bool answered = false;       // lockstep: answered the current tick
+  bool busy = false;
+  Phase phase = Phase::kIdle;
+  std::uint64_t owner = 0;     // agent instance flying this drone, 0 = none
+  bool live = false;
+  double last_heard_wall = -1e9;
+};
+
+}  // namespace
+
+struct SimServer::Impl {
+  ServerConfig cfg;
+  const int n;
+  const double period_s;
+  const double dt_s;
+  std::vector<Eigen::Vector3d> starts;
+  PhysicsWorld world;
+  std::vector<FlightController> controllers;
+  std::vector<std::mt19937_64> sensor_rng;
+  TaskReferee referee;
+
+  Participant dds;
+  Writer<msg::SwarmState> w_swarm;
+  Writer<msg::DroneState> w_drone;
+  Writer<msg::DistanceScan> w_scan;
+  Writer<msg::Scene> w_scene;
+  Writer<msg::SimStatus> w_status;
+  Writer<msg::CollisionEvent> w_collision;
+  Writer<msg::TaskStatus> w_task;
+
+  // Shared with DDS callbacks: guarded by mu.
+  std::mutex mu;
+  std::condition_variable cv;
+  std::vector<Slot> slots;
+  std::deque<msg::MissionCommand> pending_missions;
+  std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
+  std::uint64_t published_tick = 0;
+  double agent_d_int = 0;
+  msg::SimStatus counters;  // rejected_* and commands_* live here
+
+  // Main thread only.
+  std::uint64_t tick = 0;
+  std::vector<VelocitySetpoint> applied;
+  std::vector<double> failsafe_since;  // sim time entered failsafe, <0 = not in failsafe
+  std::vector<std::uint32_t> coll_obstacle, coll_drone, coll_ground;
+  std::vector<float> cmd_age_s;
+  std::deque<msg::MissionCommand> recent;
+  double d_int = 0;
+  msg::SwarmState swarm_msg;
+  bool paused = false;
+  std::string state_text = "starting";
+  double last_status_wall = -1e9, rtf_wall = 0, rtf_sim = 0, rtf = 0;
+  double start_wall = 0;
+  TaskPhase last_task_phase = TaskPhase::kNone;
+  double last_task_publish_wall = -1e9;
+
+  explicit Impl(ServerConfig c)
+      : cfg(std::move(c)),
+        n(cfg.scenario.drones),
+        period_s(1.0 / cfg.sim.control_rate_hz),
+        dt_s(1.0 / cfg.sim.physics_rate_hz),
+        starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
+        world(cfg.scene, cfg.quadrotor, starts, cfg.scene.start.yaw_rad),
+        referee(cfg.scene),
+        dds(cfg.dds, "ddswarm-sim"),
+        w_swarm(dds.writer<msg::SwarmState>()),
+        w_drone(dds.writer<msg::DroneState>()),
+        w_scan(dds.writer<msg::DistanceScan>()),
+        w_scene(dds.writer<msg::Scene>()),
+        w_status(dds.writer<msg::SimStatus>()),
+        w_collision(dds.writer<msg::CollisionEvent>()),
+        w_task(dds.writer<msg::TaskStatus>()) {
+    for (int i = 0; i < n; ++i) {
+      controllers.emplace_back(cfg.quadrotor, cfg.controller);
+      controllers.back().reset(cfg.scene.start.yaw_rad);
+      // One generator per drone: a drone's noise does not depend on the others.
+      sensor_rng.emplace_back(cfg.scenario.seed * 1000003ULL + static_cast<std::uint64_t>(i));
+    }
+    slots.resize(n);
+    applied.resize(n);
+    failsafe_since.assign(n, -1.0);
+    coll_obstacle.assign(n, 0);
+    coll_drone.assign(n, 0);
+    coll_ground.assign(n, 0);
+    cmd_age_s.assign(n, 0.f);
+    swarm_msg.drones().resize(n);
+    swarm_msg.scans().resize(n);
+    for (int i = 0; i < n; ++i) {
+      auto& sc = swarm_msg.scans()[i];
+      sc.drone_id(static_cast<std::uint16_t>(i));
+      sc.max_range_m(static_cast<float>(cfg.sensors.max_range_m));
+      for (int k = 0; k < cfg.sensors.count; ++k)
+        sc.angle_body_rad().push_back(
+            static_cast<float>(cfg.sensors.yaw_offset_rad + 2.0 * M_PI * k / cfg.sensors.count));
+    }
+    counters.num_drones(static_cast<std::uint16_t>(n));
+    counters.mode(cfg.scenario.mode == TimeMode::kLockstep ? msg::MODE_LOCKSTEP : msg::MODE_REALTIME);
+
+    dds.reader<msg::VelocityCommand>(
+        [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); });
+    dds.reader<msg::AgentStatus>(
+        [this](const msg::AgentStatus& s, const fdds::SampleInfo&) { on_heartbeat(s); });
+    dds.reader<msg::MissionCommand>(
+        [this](const msg::MissionCommand& m, const fdds::SampleInfo&) { on_mission(m); });
+    publish_scene();
+  }
+
+  // ---- DDS callbacks (Fast DDS threads) ----
+
+  void on_command(const msg::VelocityCommand& c) {
+    std::lock_guard<std::mutex> lock(mu);
+    CommandFacts f{c.drone_id(), c.tick(), from_msg(c.velocity()), c.yaw_rate_rad_s(),
+                   c.agent_instance()};
+    GateContext g{n, published_tick, 0, 0, cfg.sim.max_command_speed_mps};
+    if (c.drone_id() < n) {
+      const Slot& s = slots[c.drone_id()];
+      g.owner_instance = s.live ? s.owner : 0;
+      g.oldest_ok_tick = cfg.scenario.mode == TimeMode::kLockstep
+                             ? published_tick
+                             : (s.has_command ? s.command_tick : 0);
+    }
+    Verdict v = check_command(f, g);
+    switch (v) {
+      case Verdict::kAccept: break;
+      case Verdict::kNonFinite: counters.rejected_non_finite(counters.rejected_non_finite() + 1); return;
+      case Verdict::kAbsurd: counters.rejected_absurd(counters.rejected_absurd() + 1); return;
+      case Verdict::kUnknownId: counters.rejected_unknown_id(counters.rejected_unknown_id() + 1); return;
+      case Verdict::kImpostor: counters.rejected_impostor(counters.rejected_impostor() + 1); return;
+      case Verdict::kStaleTick: counters.rejected_stale_tick(counters.rejected_stale_tick() + 1); return;
+      case Verdict::kFutureTick: counters.rejected_future_tick(counters.rejected_future_tick() + 1); return;
+    }
+    Slot& s = slots[c.drone_id()];
+    adopt(s, c.agent_instance(), c.drone_id());
+    s.setpoint.v_world = f.velocity;
+    s.setpoint.yaw_rate_rad_s = f.yaw_rate;
+    s.setpoint.motors_on = c.motors_on();
+    s.has_command = true;
+    s.command_tick = c.tick();
+    s.phase = static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
+    s.busy = c.busy();
+    if (c.tick() == published_tick) s.answered = true;
+    cv.notify_all();
+  }
+
+  void on_heartbeat(const msg::AgentStatus& a) {
+    std::lock_guard<std::mutex> lock(mu);
+    if (a.drone_id() >= n) {
+      counters.rejected_unknown_id(counters.rejected_unknown_id() + 1);
+      return;
+    }
+    Slot& s = slots[a.drone_id()];
+    if (s.live && s.owner != a.agent_instance()) {
+      counters.rejected_impostor(counters.rejected_impostor() + 1);
+      return;
+    }
+    adopt(s, a.agent_instance(), a.drone_id());
+    if (std::isfinite(a.inter_distance_m()) && a.inter_distance_m() > 0)
+      agent_d_int = std::max(agent_d_int, a.inter_distance_m());
+    cv.notify_all();
+  }
+
+  void adopt(Slot& s, std::uint64_t instance, int id) {
+    if (!s.live) {
+      spdlog::info("drone {}: agent {:016x} online", id, instance);
+      s.live = true;
+      s.owner = instance;
+      s.answered = false;
+    }
+    s.last_heard_wall = wall_seconds();
+  }
+
+  void on_mission(const msg::MissionCommand& m) {
+    std::lock_guard<std::mutex> lock(mu);
+    std::string problem = mission_problem(m);
+    if (!problem.empty()) {
+      counters.rejected_mission(counters.rejected_mission() + 1);
+      spdlog::warn("mission command seq {} rejected: {}", m.seq(), problem);
+      return;
+    }
+    if (!seen_missions.insert({m.issuer_instance(), m.seq()}).second) return;  // redelivered
+    pending_missions.push_back(m);
+    cv.notify_all();
+  }
+
+  // ---- main loop ----
+
+  /// Marks agents silent for longer than agent_timeout_s as lost. Call with mu held.
+  void expire_agents() {
+    double now = wall_seconds();
+    for (int i = 0; i < n; ++i) {
+      Slot& s = slots[i];
+      if (s.live && now - s.last_heard_wall > cfg.sim.agent_timeout_s) {
+        s.live = false;
+        s.owner = 0;
+        counters.lockstep_timeouts(counters.lockstep_timeouts() + 1);
+        spdlog::warn("drone {}: agent lost (silent for {:.1f} s); drone enters failsafe", i,
+                     now - s.last_heard_wall);
+      }
+    }
+  }
+
+  /// Releases at most one pending mission command onto this tick. Call with mu held.
+  void release_mission() {
+    if (pending_missions.empty()) return;
+    msg::MissionCommand m = pending_missions.front();
+    pending_missions.pop_front();
+    m.apply_tick(tick);
+    recent.push_back(m);
+    while (recent.size() > 8) recent.pop_front();
+    auto type = static_cast<MissionType>(m.type());
+    spdlog::info("tick {}: mission seq {} {} released", tick, m.seq(), to_string(type));
+    if (type == MissionType::kSetDistance) d_int = m.value();
+    if (referee.running() && (type == MissionType::kLand || type == MissionType::kTask ||
+                              type == MissionType::kMove || type == MissionType::kFollowLeader))
+      referee.fail(std::string("aborted by ") + to_string(type) + " command");
+    if (type == MissionType::kTask) {
+      double dint = d_int > 0 ? d_int : (agent_d_int > 0 ? agent_d_int : 4.0);
+      double eps = m.epsilon_m() > 0 ? m.epsilon_m() : 2.5 * dint;
+      referee.start(m.seq(), sim_time(), eps, m.value(), n);
+    }
+  }
+
+  double sim_time() const { return static_cast<double>(tick) * period_s; }
+
+  /// Chooses each drone's setpoint for the coming period. Call with mu held.
+  void select_setpoints() {
+    const double t = sim_time();
+    for (int i = 0; i < n; ++i) {
+      Slot& s = slots[i];
+      bool fresh = s.has_command && s.live &&
+                   (static_cast<double>(tick - std::min(tick, s.command_tick)) * period_s <=
+                    cfg.sim.command_timeout_s);
+      if (fresh) {
+        if (failsafe_since[i] >= 0) spdlog::info("drone {}: commands resumed, leaving failsafe", i);
+        failsafe_since[i] = -1;
+        applied[i] = s.setpoint;
+        cmd_age_s[i] = static_cast<float>((tick - std::min(tick, s.command_tick)) * period_s);
+        counters.commands_applied(counters.commands_applied() + 1);
+        continue;
+      }
+      // Failsafe: hover in place, land after a while (PX4's offboard-loss behaviour).
+      bool airborne = world.state(i).p_world.z() > cfg.scene.ground_z_m + cfg.sim.airborne_height_m;
+      if (failsafe_since[i] < 0) {
+        if (!airborne && !applied[i].motors_on) continue;  // idle on the ground: not a failsafe
+        failsafe_since[i] = t;
+        spdlog::warn("drone {}: no fresh command, failsafe (hover, land after {:.0f} s)", i,
+                     cfg.sim.failsafe_land_after_s);
+      }
+      VelocitySetpoint sp;
+      sp.motors_on = airborne || (t - failsafe_since[i] < cfg.sim.failsafe_land_after_s);
+      if (t - failsafe_since[i] >= cfg.sim.failsafe_land_after_s) sp.v_world = {0, 0, -0.5};
+      if (!airborne && t - failsafe_since[i] >= cfg.sim.failsafe_land_after_s) sp.motors_on = false;
+      applied[i] = sp;
+    }
+  }
+
+  void step_physics() {
+    const int substeps = cfg.sim.substeps();
+    for (int k = 0; k < substeps; ++k) {
+      for (int i = 0; i < n; ++i) {
+        auto omega = controllers[i].update(world.state(i), applied[i], dt_s);
+        world.set_rotor_commands(i, omega);
+      }
+      world.step(dt_s);
+    }
+    for (const auto& e : world.take_contact_events()) on_contact(e);
+  }
+
+  void on_contact(const ContactEvent& e) {
+    int kind = e.kind == ContactKind::kObstacle ? 0 : e.kind == ContactKind::kDrone ? 1 : 2;
+    if (kind == 2) {
+      Phase p;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        p = slots[e.drone].phase;
+      }
+      // Touching the ground is a collision only while the drone means to fly.
+      if (!flying_phase(p) || failsafe_since[e.drone] >= 0) return;
+      ++coll_ground[e.drone];
+    } else if (kind == 0) {
+      ++coll_obstacle[e.drone];
+    } else {
+      ++coll_drone[e.drone];
+      if (e.other >= 0 && e.other < n) ++coll_drone[e.other];
+    }
+    referee.count_collision(kind);
+    msg::CollisionEvent m;
+    m.tick(tick);
+    m.sim_time_s(sim_time());
+    m.drone_id(static_cast<std::uint16_t>(e.drone));
+    m.kind(static_cast<std::uint8_t>(kind));
+    m.other(e.other);
+    m.where(to_msg(e.where_world));
+    w_collision.write(m);
+    spdlog::info("t={:.2f}s collision: drone {} with {} {}", sim_time(), e.drone,
+                 kind == 0 ? "obstacle" : kind == 1 ? "drone" : "ground", e.other);
+  }
+
+  void publish_scene() {
+    msg::Scene s;
+    s.name(cfg.scenario.name.substr(0, 127));
+    s.seed(cfg.scenario.seed);
+    s.num_drones(static_cast<std::uint16_t>(n));
+    s.mode(cfg.scenario.mode == TimeMode::kLockstep ? msg::MODE_LOCKSTEP : msg::MODE_REALTIME);
+    s.physics_rate_hz(cfg.sim.physics_rate_hz);
+    s.control_rate_hz(cfg.sim.control_rate_hz);
+    s.ground_z_m(cfg.scene.ground_z_m);
+    for (const auto& c : cfg.scene.cylinders) {
+      msg::Cylinder m;
+      m.x(c.center_xy.x());
+      m.y(c.center_xy.y());
+      m.radius_m(c.radius_m);
+      m.height_m(c.height_m);
+      s.cylinders().push_back(m);
+    }
+    for (const auto& b : cfg.scene.boxes) {
+      msg::Box m;
+      m.center(to_msg(b.center));
+      m.size(to_msg(b.size));
+      m.yaw_rad(b.yaw_rad);
+      s.boxes().push_back(m);
+    }
+    s.bounds_min(to_msg(cfg.scene.bounds_min));
+    s.bounds_max(to_msg(cfg.scene.bounds_max));
+    s.finish_a(to_msg(Eigen::Vector3d(cfg.scene.finish_a.x(), cfg.scene.finish_a.y(), 0)));
+    s.finish_b(to_msg(Eigen::Vector3d(cfg.scene.finish_b.x(), cfg.scene.finish_b.y(), 0)));
+    s.goal(to_msg(Eigen::Vector3d(cfg.scene.goal_xy.x(), cfg.scene.goal_xy.y(), 0)));
+    s.start_center(to_msg(Eigen::Vector3d(cfg.scene.start.center_xy.x(), cfg.scene.start.center_xy.y(), 0)));
+    for (const auto& p : starts) s.start_positions().push_back(to_msg(p));
+    s.drone_radius_m(cfg.quadrotor.collision_radius_m);
+    s.arm_length_m(cfg.quadrotor.arm_length_m);
+    s.sensor_count(static_cast<std::uint16_t>(cfg.sensors.count));
+    s.sensor_max_range_m(static_cast<float>(cfg.sensors.max_range_m));
+    w_scene.write(s);
+  }
+
+  void publish_tick() {
+    const double t = sim_time();
+    const bool scan_tick = tick % static_cast<std::uint64_t>(cfg.sim.sensor_every()) == 0;
+    std::vector<float> ranges;
+    std::vector<std::uint8_t> hits;
+    std::vector<Eigen::Vector3d> positions;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      release_mission();
+      swarm_msg.recent_commands().assign(recent.begin(), recent.end());
+      published_tick = tick;
+      for (auto& s : slots) s.answered = false;
+    }
+    swarm_msg.tick(tick);
+    swarm_msg.sim_time_s(t);
+    for (int i = 0; i < n; ++i) {
+      RigidState st = world.state(i);
+      auto omega = world.rotor_speeds(i);
+      auto& d = swarm_msg.drones()[i];
+      d.drone_id(static_cast<std::uint16_t>(i));
+      d.tick(tick);
+      d.sim_time_s(t);
+      d.position(to_msg(st.p_world));
+      d.orientation(to_msg(st.q_world_body));
+      d.velocity(to_msg(st.v_world));
+      d.angular_velocity(to_msg(st.w_body));
+      for (int k = 0; k < 4; ++k) d.motor_speed_rad_s()[k] = static_cast<float>(omega[k]);
+      d.collisions_obstacle(coll_obstacle[i]);
+      d.collisions_drone(coll_drone[i]);
+      d.collisions_ground(coll_ground[i]);
+      std::uint16_t flags = 0;
+      bool airborne = st.p_world.z() > cfg.scene.ground_z_m + cfg.sim.airborne_height_m;
+      if (airborne) flags |= msg::DRONE_AIRBORNE;
+      if (failsafe_since[i] >= 0) flags |= msg::DRONE_FAILSAFE;
+      Phase phase;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        if (slots[i].live) flags |= msg::DRONE_AGENT_LIVE;
+        phase = slots[i].phase;
+      }
+      if ((st.p_world.array() < cfg.scene.bounds_min.array()).any() ||
+          (st.p_world.array() > cfg.scene.bounds_max.array()).any())
+        flags |= msg::DRONE_OUT_OF_BOUNDS;
+      if (cfg.scene.past_finish(st.p_world.head<2>())) flags |= msg::DRONE_PAST_FINISH;
+      if (applied[i].motors_on) flags |= msg::DRONE_MOTORS_ON;
+      d.flags(flags);
+      d.phase(static_cast<std::uint8_t>(phase));
+      d.command_age_s(cmd_age_s[i]);
+      if (scan_tick) {
+        auto& sc = swarm_msg.scans()[i];
+        world.cast_rays(i, cfg.sensors, sensor_rng[i], ranges, hits);
+        sc.tick(tick);
+        sc.sim_time_s(t);
+        sc.range_m().assign(ranges.begin(), ranges.end());
+        sc.hit().assign(hits.begin(), hits.end());
+      }
+      if (failsafe_since[i] < 0) positions.push_back(st.p_world);
+      else if (referee.running()) {}  // a drone in failsafe no longer counts for the task
+    }
+    bool task_changed = referee.update(t, positions, cfg.sim.task_timeout_s);
+    w_swarm.write(swarm_msg);
+    if (cfg.sim.publish_per_drone_topics) {
+      for (int i = 0; i < n; ++i) {
+        w_drone.write(swarm_msg.drones()[i]);
+        if (scan_tick) w_scan.write(swarm_msg.scans()[i]);
+      }
+    }
+    publish_task(task_changed);
+  }
+
+  void publish_task(bool changed) {
+    const auto& r = referee.report();
+    double now = wall_seconds();
+    if (!changed && !(r.phase == TaskPhase::kRunning && now - last_task_publish_wall > 0.5) &&
+        r.phase == last_task_phase)
+      return;
+    if (r.phase == TaskPhase::kRunning && last_task_phase != TaskPhase::kRunning)
+      task_start_wall = now;
+    last_task_phase = r.phase;
+    last_task_publish_wall = now;
+    msg::TaskStatus m;
+    m.seq(r.seq);
+    m.phase(static_cast<std::uint8_t>(r.phase));
+    m.reason(r.reason.substr(0, 127));
+    m.start_sim_time_s(r.start_sim_time_s);
+    m.elapsed_s(r.elapsed_s);
+    m.start_wall_time_s(task_start_wall - start_wall);
+    m.wall_elapsed_s(now - task_start_wall);
+    m.epsilon_m(r.epsilon_m);
+    m.speed_mps(r.speed_mps);
+    m.drones(static_cast<std::uint16_t>(r.drones));
+    m.past_finish(static_cast<std::uint16_t>(r.past_finish));
+    m.max_pair_distance_m(r.max_pair_distance_m);
+    m.min_inter_drone_m(std::isfinite(r.min_inter_drone_m) ? r.min_inter_drone_m : -1);
+    m.min_clearance_m(std::isfinite(r.min_clearance_m) ? r.min_clearance_m : -1);
+    m.collisions_obstacle(r.collisions_obstacle);
+    m.collisions_drone(r.collisions_drone);
+    m.collisions_ground(r.collisions_ground);
+    w_task.write(m);
+    if (changed && r.phase == TaskPhase::kComplete)
+      spdlog::info("task complete: {:.2f} s sim, {} obstacle / {} drone / {} ground collisions, "
+                   "min distance {:.2f} m, min clearance {:.2f} m",
+                   r.elapsed_s, r.collisions_obstacle, r.collisions_drone, r.collisions_ground,
+                   r.min_inter_drone_m, r.min_clearance_m);
+    if (changed && r.phase == TaskPhase::kFailed) spdlog::warn("task failed: {}", r.reason);
+  }
+  double task_start_wall = 0;
+
+  void publish_status(bool force) {
+    double now = wall_seconds();
+    if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz) return;
+    double dw = now - rtf_wall;
+    if (dw >= 0.5) {
+      rtf = (sim_time() - rtf_sim) / dw;
+      rtf_wall = now;
+      rtf_sim = sim_time();
+    }
+    last_status_wall = now;
+    msg::SimStatus s;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      s = counters;
+      int live = 0;
+      for (const auto& sl : slots) live += sl.live;
+      s.agents_live(static_cast<std::uint16_t>(live));
+    }
+    s.tick(tick);
+    s.sim_time_s(sim_time());
+    s.wall_time_s(now - start_wall);
+    s.state(state_text);
+    s.real_time_factor(paused ? 0.0 : rtf);
+    int airborne = 0, failsafe = 0;
+    std::uint32_t co = 0, cd = 0, cg = 0;
+    for (int i = 0; i < n; ++i) {
+      airborne += swarm_msg.drones()[i].flags() & msg::DRONE_AIRBORNE ? 1 : 0;
+      failsafe += failsafe_since[i] >= 0;
+      co += coll_obstacle[i];
+      cd += coll_drone[i];
+      cg += coll_ground[i];
+    }
+    s.airborne(static_cast<std::uint16_t>(airborne));
+    s.failsafe(static_cast<std::uint16_t>(failsafe));
+    s.collisions_obstacle(co);
+    s.collisions_drone(cd / 2);  // each drone-drone contact counted on both drones
+    s.collisions_ground(cg);
+    w_status.write(s);
+  }
+
+  void advance() {
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      select_setpoints();
+    }
+    step_physics();
+    ++tick;
+    publish_tick();
+    publish_status(false);
+  }
+
+  void run_realtime(double deadline_wall) {
+    state_text = "running";
+    publish_tick();
+    auto next = Clock::now();
+    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
+    while (!stop_requested() && wall_seconds() < deadline_wall) {
+      next += period;
+      auto now = Clock::now();
+      if (next < now - 10 * period) {
+        spdlog::warn("real time slipped by {:.0f} ms; resynchronising",
+                     std::chrono::duration<double, std::milli>(now - next).count());
+        next = now;
+      }
+      std::this_thread::sleep_until(next);
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        expire_agents();
+      }
+      advance();
+    }
+  }
+
+  /// Lockstep: true when every live agent has answered the published tick.
+  bool all_answered() {
+    for (const auto& s : slots)
+      if (s.live && !s.answered) return false;
+    return true;
+  }
+  bool swarm_idle() {
+    for (const auto& s : slots)
+      if (s.live && s.busy) return false;
+    return true;
+  }
+
+  void run_lockstep(double deadline_wall) {
+    publish_tick();
+    double last_republish = wall_seconds();
+    while (!stop_requested() && wall_seconds() < deadline_wall) {
+      bool go = false;
+      {
+        std::unique_lock<std::mutex> lock(mu);
+        expire_agents();
+        bool answered = all_answered();
+        bool idle = cfg.sim.pause_when_idle && answered && swarm_idle() && pending_missions.empty();
+        bool was_paused = paused;
+        paused = idle;
+        state_text = paused ? "paused: swarm idle" : answered ? "running" : "waiting for agents";
+        go = answered && !idle;
+        if (!go) cv.wait_for(lock, std::chrono::milliseconds(paused ? 50 : 20));
+        if (paused != was_paused) last_status_wall = -1e9;
+      }
+      if (go) {
+        advance();
+        last_republish = wall_seconds();
+        continue;
+      }
+      // Waiting: a late joiner or a lost sample must not stall the loop forever.
+      if (wall_seconds() - last_republish > 0.25) {
+        w_swarm.write(swarm_msg);
+        last_republish = wall_seconds();
+      }
+      publish_status(false);
+    }
+  }
+
+  void run(double duration_s) {
+    start_wall = wall_seconds();
+    rtf_wall = start_wall;
+    double deadline = duration_s > 0 ? start_wall + duration_s : 1e300;
+    spdlog::info("ddswarm-sim: scenario '{}', {} drones, {} mode, physics {} Hz, control {} Hz, seed {}",
+                 cfg.scenario.name, n, to_string(cfg.scenario.mode), cfg.sim.physics_rate_hz,
+                 cfg.sim.control_rate_hz, cfg.scenario.seed);
+    if (cfg.scenario.mode == TimeMode::kLockstep)
+      run_lockstep(deadline);
+    else
+      run_realtime(deadline);
+    state_text = "stopping";
+    publish_status(true);
+    spdlog::info("ddswarm-sim: stopped at tick {} (sim {:.2f} s)", tick, sim_time());
+  }
+};
+
+SimServer::SimServer(ServerConfig cfg) : impl_(std::make_unique<Impl>(std::move(cfg))) {}
+SimServer::~SimServer() = default;
+void SimServer::run(double duration_s) { impl_->run(duration_s); }
+
+}  // namespace ddswarm::sim

@@ -1,0 +1,45 @@
+#pragma once
+// The simulation server: steps every quadrotor, casts their sensors, counts
+// collisions, referees the task, and talks DDS. One per swarm.
+#include <memory>
+#include <string>
+
+#include "common/dds_config.hpp"
+#include "common/scenario.hpp"
+#include "common/scene.hpp"
+#include "sim_server/flight_controller.hpp"
+#include "sim_server/physics_world.hpp"
+#include "sim_server/quadrotor.hpp"
+#include "sim_server/sim_config.hpp"
+
+namespace ddswarm::sim {
+
+/// Everything the server reads from a scenario file.
+struct ServerConfig {
+  ScenarioConfig scenario;
+  SimConfig sim;
+  QuadrotorParams quadrotor;
+  ControllerConfig controller;
+  SensorConfig sensors;
+  SceneConfig scene;
+  DdsConfig dds;
+  void validate() const;
+};
+
+/// Loads and validates path; throws ConfigError "file:line: field = value: reason".
+ServerConfig load_server_config(const std::string& path);
+
+class SimServer {
+ public:
+  /// Builds the world and joins DDS; throws on failure (message names what failed).
+  explicit SimServer(ServerConfig cfg);
+  ~SimServer();
+  /// Runs until stop_requested() or duration_s of wall time (<= 0: forever).
+  void run(double duration_s);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ddswarm::sim

@@ -1,0 +1,67 @@
+#include "sim_server/task_referee.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace ddswarm::sim {
+
+void TaskReferee::start(std::uint32_t seq, double t, double epsilon_m, double speed_mps, int drones) {
+  r_ = TaskReport{};
+  r_.seq = seq;
+  r_.phase = TaskPhase::kRunning;
+  r_.start_sim_time_s = t;
+  r_.epsilon_m = epsilon_m;
+  r_.speed_mps = speed_mps;
+  r_.drones = drones;
+  r_.min_inter_drone_m = std::numeric_limits<double>::infinity();
+  r_.min_clearance_m = std::numeric_limits<double>::infinity();
+}
+
+void TaskReferee::fail(const std::string& reason) {
+  if (r_.phase != TaskPhase::kRunning) return;
+  r_.phase = TaskPhase::kFailed;
+  r_.reason = reason;
+}
+
+void TaskReferee::count_collision(int kind) {
+  if (r_.phase != TaskPhase::kRunning) return;
+  if (kind == 0) ++r_.collisions_obstacle;
+  if (kind == 1) ++r_.collisions_drone;
+  if (kind == 2) ++r_.collisions_ground;
+}
+
+bool TaskReferee::update(double t, const std::vector<Eigen::Vector3d>& p, double timeout_s) {
+  if (r_.phase != TaskPhase::kRunning) return false;
+  r_.elapsed_s = t - r_.start_sim_time_s;
+  r_.drones = static_cast<int>(p.size());
+  double max_pair = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t j = i + 1; j < p.size(); ++j) {
+      double d = (p[i] - p[j]).norm();
+      max_pair = std::max(max_pair, d);
+      r_.min_inter_drone_m = std::min(r_.min_inter_drone_m, d);
+    }
+    r_.min_clearance_m = std::min(r_.min_clearance_m, scene_.clearance(p[i]));
+  }
+  r_.max_pair_distance_m = max_pair;
+  r_.past_finish = static_cast<int>(std::count_if(
+      p.begin(), p.end(), [&](const Eigen::Vector3d& q) { return scene_.past_finish(q.head<2>()); }));
+  if (p.empty()) {
+    r_.phase = TaskPhase::kFailed;
+    r_.reason = "no drone left";
+    return true;
+  }
+  if (r_.past_finish == static_cast<int>(p.size()) && max_pair < r_.epsilon_m) {
+    r_.phase = TaskPhase::kComplete;
+    return true;
+  }
+  if (r_.elapsed_s > timeout_s) {
+    r_.phase = TaskPhase::kFailed;
+    r_.reason = "timeout after " + std::to_string(static_cast<int>(timeout_s)) + " s (" +
+                std::to_string(r_.past_finish) + "/" + std::to_string(p.size()) + " past finish)";
+    return true;
+  }
+  return false;
+}
+
+}  // namespace ddswarm::sim
