@@ -7,6 +7,8 @@
 #include <mutex>
 #include <optional>
 #include <random>
+#include <deque>
+#include <map>
 #include <set>
 
 #include "agent/mission_fsm.hpp"
@@ -79,7 +81,9 @@ struct AgentApp::Impl {
   std::unique_ptr<MissionFsm> fsm;
   TruthPeerSource truth;
   PeerSource* peers = &truth;
-  std::set<std::pair<std::uint64_t, std::uint32_t>> applied_missions;
+  // (issuer, seq) -> the apply_tick it came with; oldest first for pruning.
+  std::map<std::pair<std::uint64_t, std::uint32_t>, std::uint64_t> seen_missions;
+  std::deque<std::pair<std::uint64_t, std::uint32_t>> seen_order;
   std::uint32_t last_mission_seq = 0;
   std::uint64_t last_tick = 0;
   bool have_tick = false;
@@ -193,7 +197,20 @@ struct AgentApp::Impl {
     obs.on_ground = obs.p_world.z() < scene->ground_z_m + 0.15 && obs.v_world.norm() < 0.5;
 
     for (const auto& m : s.recent_commands()) {
-      if (!applied_missions.insert({m.issuer_instance(), m.seq()}).second) continue;
+      const auto key = std::make_pair(m.issuer_instance(), m.seq());
+      auto it = seen_missions.find(key);
+      // Same command at the same apply tick: already handled (the ring repeats every tick).
+      if (it != seen_missions.end() && it->second == m.apply_tick()) continue;
+      if (it == seen_missions.end()) {
+        seen_order.push_back(key);
+        if (seen_order.size() > 1024) {
+          seen_missions.erase(seen_order.front());
+          seen_order.pop_front();
+        }
+      }
+      // A new apply tick for a known command is a repeat: the FSM returns the
+      // ack it gave then and changes nothing, so it is acknowledged again, applied once.
+      seen_missions[key] = m.apply_tick();
       MissionCommand c = from_msg(m);
       if (!mission_problem(m).empty()) {
         ++rejected;

@@ -121,7 +121,6 @@ void AgentConfig::validate() const {
   }
   check_positive("agent.teleop_timeout_s", teleop_timeout_s);
   check_positive("agent.server_timeout_s", server_timeout_s);
-  check_positive("agent.settle_speed_mps", settle_speed_mps);
 }
 
 void load(YamlSection s, ActivationConfig& c) {
@@ -163,7 +162,6 @@ void load(YamlSection s, AgentConfig& c) {
   s.get("task_speed_mps", c.task_speed_mps);
   s.get("teleop_timeout_s", c.teleop_timeout_s);
   s.get("server_timeout_s", c.server_timeout_s);
-  s.get("settle_speed_mps", c.settle_speed_mps);
   s.finish();
 }
 

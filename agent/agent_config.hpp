@@ -63,7 +63,6 @@ struct AgentConfig {
   double task_speed_mps = 0.8;     ///< m/s, task speed when the command gives 0; (0, max_speed]
   double teleop_timeout_s = 1.0;   ///< s (sim), leader's teleop velocity drops to 0 after this; > 0
   double server_timeout_s = 1.0;   ///< s (wall), no server sample for this long -> failsafe; > 0
-  double settle_speed_mps = 0.05;  ///< m/s, below this speed a drone counts as settled; > 0
 
   void validate() const;  ///< throws FieldError("agent.…")
 };

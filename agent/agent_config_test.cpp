@@ -58,7 +58,6 @@ agent:
   task_speed_mps: 1.2
   teleop_timeout_s: 0.5
   server_timeout_s: 2
-  settle_speed_mps: 0.1
   activation:
     type: custom
     points: [[-3, -2], [0, 0], [2, 0.5]]
@@ -81,7 +80,6 @@ agent:
   EXPECT_EQ(c.task_speed_mps, 1.2);
   EXPECT_EQ(c.teleop_timeout_s, 0.5);
   EXPECT_EQ(c.server_timeout_s, 2);
-  EXPECT_EQ(c.settle_speed_mps, 0.1);
   EXPECT_EQ(c.activation.type, ActivationType::kCustom);
   ASSERT_EQ(c.activation.points.size(), 3u);
   EXPECT_EQ(c.activation.points[0], Eigen::Vector2d(-3, -2));

@@ -140,6 +140,7 @@ std::string MissionFsm::execute(const MissionCommand& c, const Observation& o) {
       if (phase_ == Phase::kTakeoff) return "still taking off";
       if (phase_ == Phase::kLanding) cruise_z_m_ = clamp_cruise(o.p_world.z());
       phase_ = Phase::kHold;
+      hold_end_s_ = o.sim_time_s + c.duration_s;
       return "";
     case MissionType::kTeleop: {
       if (auto bad = check_velocity(c.velocity, cfg_.max_speed_mps); !bad.empty()) return bad;
@@ -185,7 +186,6 @@ MissionOutput MissionFsm::step(const Observation& o) {
   out.obstacle_avoidance_enabled = out.swarm_enabled;
   out.altitude_target_m = cruise_z_m_;
   out.altitude_hold = cfg_.altitude_hold;
-  const bool settled = o.v_world.norm() < cfg_.settle_speed_mps;
 
   switch (phase_) {
     case Phase::kIdle:
@@ -196,9 +196,12 @@ MissionOutput MissionFsm::step(const Observation& o) {
       out.altitude_hold = true;
       out.busy = true;
       break;
+    // Waiting for the operator: the lockstep clock may pause, so the next
+    // command lands on a tick the simulation chose, not the operator's wall clock.
     case Phase::kHold:
+      out.busy = o.sim_time_s < hold_end_s_;
+      break;
     case Phase::kSwarm:
-      out.busy = !settled;
       break;
     case Phase::kMove:
       out.mission_velocity = move_velocity_;

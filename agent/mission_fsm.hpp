@@ -81,7 +81,8 @@ class MissionFsm {
 
   /// Advances timed transitions and returns this tick's mission output. Call
   /// every control tick. busy: false in idle; true in takeoff, move, task,
-  /// follow and landing; in hold and swarm true until |v_world| < settle_speed_mps.
+  /// follow and landing; in hold only until a timed hold (duration_s) ends; false in
+  /// swarm (the server keeps its clock running while it referees the task).
   MissionOutput step(const Observation& o);
 
   Phase phase() const { return phase_; }
@@ -107,6 +108,7 @@ class MissionFsm {
   double d_int_m_;
   double cruise_z_m_ = 0;  // world z held by the altitude loop
   double move_end_s_ = 0;  // sim time a move ends
+  double hold_end_s_ = 0;  // sim time a timed hold ends (the lockstep clock runs until then)
   Eigen::Vector3d move_velocity_{0, 0, 0};
   double task_speed_mps_ = 0;
   int leader_id_ = -1;

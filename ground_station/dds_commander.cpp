@@ -120,13 +120,21 @@ struct DdsCommander::Impl {
     if (!w_mission.write(m)) return {false, "DDS refused the command"};
     lock.lock();
     const std::uint32_t s = c.seq;
-    cv.wait_for(lock, std::chrono::duration<double>(cfg.ack_timeout_s), [&] {
+    auto all_in = [&] {
       if (stop_requested()) return true;
       const auto& got = acks[s];
       for (int id : expect)
         if (!got.count(id)) return false;
       return true;
-    });
+    };
+    // One retry with the same seq after a third of the timeout: agents that
+    // applied it only acknowledge again.
+    if (!cv.wait_for(lock, std::chrono::duration<double>(cfg.ack_timeout_s / 3), all_in)) {
+      lock.unlock();
+      w_mission.write(m);
+      lock.lock();
+      cv.wait_for(lock, std::chrono::duration<double>(cfg.ack_timeout_s * 2 / 3), all_in);
+    }
     const auto& got = acks[s];
     std::vector<int> missing;
     std::string rejected;
@@ -164,6 +172,15 @@ bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
     int want = count >= 0 ? count : impl_->sim->num_drones();
     return static_cast<int>(impl_->online_locked().size()) >= want &&
            impl_->w_mission.matched() > 0;
+  }) && !stop_requested();
+}
+
+bool DdsCommander::wait_for_server(double timeout_s) {
+  std::unique_lock<std::mutex> lock(impl_->mu);
+  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+    if (stop_requested()) return true;
+    return impl_->sim && impl_->w_mission.matched() > 0 &&
+           static_cast<int>(impl_->online_locked().size()) >= impl_->sim->agents_live();
   }) && !stop_requested();
 }
 
@@ -223,9 +240,10 @@ CommandResult DdsCommander::teleop(const Eigen::Vector3d& v) {
   return impl_->send(c);
 }
 
-CommandResult DdsCommander::hold() {
+CommandResult DdsCommander::hold_for(double duration_s) {
   MissionCommand c;
   c.type = MissionType::kHold;
+  c.duration_s = duration_s;
   return impl_->send(c);
 }
 

@@ -33,6 +33,9 @@ class DdsCommander final : public Commander {
   /// Waits until the server is heard and count agents are online (count < 0:
   /// as many as the server's scenario has). Returns false on timeout.
   bool wait_for_swarm(int count, double timeout_s);
+  /// Waits until the server's status is heard, the mission writer is matched,
+  /// and a heartbeat has arrived from every agent the server hears.
+  bool wait_for_server(double timeout_s);
   /// Waits until sim time reaches t (s). False on timeout (wall) or stop.
   bool wait_sim_time(double t, double timeout_s);
   /// Waits until `airborne` drones are airborne (or on the ground when 0).
@@ -44,7 +47,9 @@ class DdsCommander final : public Commander {
   CommandResult land() override;
   CommandResult follow_leader(int leader_id) override;
   CommandResult teleop(const Eigen::Vector3d& v_enu) override;
-  CommandResult hold() override;
+  CommandResult hold() override { return hold_for(0); }
+  /// Holds and swarms in place for duration_s of sim time (the lockstep clock runs meanwhile).
+  CommandResult hold_for(double duration_s);
   CommandResult task(double speed_mps, double epsilon_m) override;
   std::string wait_task(std::function<void(const std::string&)> on_progress) override;
   SwarmStatus status() override;

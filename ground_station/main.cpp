@@ -14,6 +14,7 @@
 #include "ground_station/line_reader.hpp"
 #include "ground_station/menu.hpp"
 #include "ground_station/report.hpp"
+#include "ground_station/trace.hpp"
 
 using namespace ddswarm;
 using namespace ddswarm::gs;
@@ -84,6 +85,10 @@ int main(int argc, char** argv) {
     auto* land = app.add_subcommand("land", "land every drone");
     land->add_flag("--wait", wait_flag, "wait until every drone is on the ground");
     auto* hold = app.add_subcommand("hold", "stop mission motion, keep swarming");
+    double hold_s = 0;
+    hold->add_option("--time", hold_s, "swarm in place for this many sim seconds (lockstep runs the clock meanwhile)")
+        ->check(CLI::Range(0.0, 86400.0));
+    hold->add_flag("--wait", wait_flag, "wait until the time has passed (sim time)");
     auto* follow = app.add_subcommand("follow", "follow the leader: the rest swarm around it");
     int leader = 0;
     follow->add_option("--leader", leader, "leader drone id")->required()->check(CLI::Range(0, 1023));
@@ -101,6 +106,13 @@ int main(int argc, char** argv) {
     task->add_flag("--takeoff", fly, "wait for every agent, take off first, then run the task");
     task->add_option("--csv", csv, "append the result to this CSV");
     auto* status = app.add_subcommand("status", "print the swarm's status");
+    auto* trace = app.add_subcommand("trace", "write every drone's state to CSV until Ctrl-C or --duration");
+    std::string trace_out;
+    int trace_every = 5;
+    double trace_duration = 0;
+    trace->add_option("--out", trace_out, "CSV file")->required();
+    trace->add_option("--every", trace_every, "keep one tick in N")->check(CLI::Range(1, 100000));
+    trace->add_option("--duration", trace_duration, "wall seconds (0 = until Ctrl-C)");
     auto* experiment = app.add_subcommand("experiment", "run an experiment file (e.g. config/table1.yaml)");
     std::string exp_file, out_dir = "results";
     experiment->add_option("file", exp_file, "experiment YAML")->required();
@@ -126,12 +138,17 @@ int main(int argc, char** argv) {
       return run_experiment(exp, opt, std::cout);
     }
 
+    if (*trace) {
+      SwarmTrace t(file.dds, trace_out, trace_every);
+      wait_for_stop(std::chrono::duration<double>(trace_duration > 0 ? trace_duration : 1e9));
+      std::printf("%ld rows written to %s\n", t.rows(), trace_out.c_str());
+      return 0;
+    }
     DdsCommander gs(file.gs, file.dds);
     const bool interactive = app.get_subcommands().empty() || *menu;
     // Give discovery a moment: the server's status is transient-local.
-    if (!gs.wait_for_swarm(interactive || *status ? 0 : 1, file.gs.discovery_timeout_s) &&
-        !interactive) {
-      std::fprintf(stderr, "ddswarm-gs: error: no simulation server or agent found on domain %d within %.0f s\n",
+    if (!gs.wait_for_server(file.gs.discovery_timeout_s) && !interactive) {
+      std::fprintf(stderr, "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",
                    file.dds.domain_id, file.gs.discovery_timeout_s);
       return 1;
     }
@@ -176,7 +193,12 @@ int main(int argc, char** argv) {
       if (rc == 0 && wait_flag && !gs.wait_airborne(0, 120)) return 1;
       return rc;
     }
-    if (*hold) return report(gs.hold());
+    if (*hold) {
+      double t0 = gs.status().sim_time_s;
+      int rc = report(gs.hold_for(hold_s));
+      if (rc == 0 && wait_flag && hold_s > 0) gs.wait_sim_time(t0 + hold_s, hold_s * 100 + 60);
+      return rc;
+    }
     if (*follow) return report(gs.follow_leader(leader));
     if (*teleop) return report(gs.teleop(Eigen::Vector3d(east, north, up)));
     if (*task) {

@@ -242,7 +242,10 @@ struct SimServer::Impl {
       spdlog::warn("mission command seq {} rejected: {}", m.seq(), problem);
       return;
     }
-    if (!seen_missions.insert({m.issuer_instance(), m.seq()}).second) return;  // redelivered
+    // A repeat (the ground station lost an ack, or re-sent its history to a
+    // restarted server) is forwarded again: agents re-acknowledge it and do not re-apply it.
+    if (!seen_missions.insert({m.issuer_instance(), m.seq()}).second)
+      spdlog::info("mission seq {} repeated: forwarding again for acknowledgement", m.seq());
     pending_missions.push_back(m);
     cv.notify_all();
   }
@@ -270,6 +273,10 @@ struct SimServer::Impl {
     msg::MissionCommand m = pending_missions.front();
     pending_missions.pop_front();
     m.apply_tick(tick);
+    // One entry per command in the ring, or agents would see it alternate between apply ticks.
+    std::erase_if(recent, [&](const msg::MissionCommand& r) {
+      return r.issuer_instance() == m.issuer_instance() && r.seq() == m.seq();
+    });
     recent.push_back(m);
     while (recent.size() > 8) recent.pop_front();
     auto type = static_cast<MissionType>(m.type());
@@ -601,7 +608,8 @@ struct SimServer::Impl {
         std::unique_lock<std::mutex> lock(mu);
         expire_agents();
         bool answered = all_answered();
-        bool idle = cfg.sim.pause_when_idle && answered && swarm_idle() && pending_missions.empty();
+        bool idle = cfg.sim.pause_when_idle && answered && swarm_idle() &&
+                    pending_missions.empty() && !referee.running();
         bool was_paused = paused;
         paused = idle;
         state_text = paused ? "paused: swarm idle" : answered ? "running" : "waiting for agents";
