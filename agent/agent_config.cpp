@@ -76,6 +76,7 @@ void SensorFunctionConfig::validate() const {
   check_positive(p + ".max_mps", max_mps);
   check_positive(p + ".log_gain_mps", log_gain_mps);
   check_non_negative(p + ".safety_distance_m", safety_distance_m);
+  check_range(p + ".slide_gain", slide_gain, 0.0, 2.0);
   if (type != SensorFunctionType::kCustom) {
     if (!points.empty())
       throw FieldError(p + ".points", std::to_string(points.size()) + " points",
@@ -96,6 +97,7 @@ void SensorFunctionConfig::validate() const {
 }
 
 void AgentConfig::validate() const {
+  check_range("agent.goal_gain", goal_gain, 1e-6, 5.0);
   check_positive("agent.inter_distance_m", inter_distance_m);
   activation.validate();
   if (activation.cutoff_m > 0 && !(activation.cutoff_m > inter_distance_m))
@@ -144,6 +146,7 @@ void load(YamlSection s, SensorFunctionConfig& c) {
   s.get("log_gain_mps", c.log_gain_mps);
   s.get("points", c.points);
   s.get("safety_distance_m", c.safety_distance_m);
+  s.get("slide_gain", c.slide_gain);
   s.finish();
 }
 
@@ -160,6 +163,7 @@ void load(YamlSection s, AgentConfig& c) {
   s.get("takeoff_speed_mps", c.takeoff_speed_mps);
   s.get("landing_speed_mps", c.landing_speed_mps);
   s.get("task_speed_mps", c.task_speed_mps);
+  s.get("goal_gain", c.goal_gain);
   s.get("teleop_timeout_s", c.teleop_timeout_s);
   s.get("server_timeout_s", c.server_timeout_s);
   s.finish();

@@ -44,6 +44,12 @@ struct SensorFunctionConfig {
   /// the other terms lose their component toward the obstacle and the
   /// repulsion is raised to agent.max_speed_mps. >= 0.
   double safety_distance_m = 0.0;
+  /// Slide along obstacles (ddswarm's addition to Eq. 3.3, 0 = the thesis's pure
+  /// law): when the obstacle term opposes the rest of the command, that blocked
+  /// part is redirected along the obstacle's surface, scaled by this gain, so a
+  /// drone dead behind a pillar goes round it instead of stalling in a local
+  /// minimum of the potential field. [0, 2].
+  double slide_gain = 1.0;
 
   void validate() const;  ///< throws FieldError("agent.sensor_function.…")
 };
@@ -61,6 +67,7 @@ struct AgentConfig {
   double takeoff_speed_mps = 1.0;     ///< m/s, climb rate limit; (0, max_speed]
   double landing_speed_mps = 0.5;  ///< m/s, descent rate, altitude-hold sink limit; (0, max_speed]
   double task_speed_mps = 0.8;     ///< m/s, task speed when the command gives 0; (0, max_speed]
+  double goal_gain = 0.3;         ///< 1/s, task gathering: pull toward the goal point, (0, 5]
   double teleop_timeout_s = 1.0;   ///< s (sim), leader's teleop velocity drops to 0 after this; > 0
   double server_timeout_s = 1.0;   ///< s (wall), no server sample for this long -> failsafe; > 0
 

@@ -201,8 +201,15 @@ MissionOutput MissionFsm::step(const Observation& o) {
     case Phase::kHold:
       out.busy = o.sim_time_s < hold_end_s_;
       break;
-    case Phase::kSwarm:
+    case Phase::kSwarm: {
+      // Gather around the goal (thesis §3.1: "reaches it, and swarms around
+      // it"), so the swarm settles past the line rather than straddling it.
+      const Eigen::Vector2d to_goal = scene_.goal_xy - o.p_world.head<2>();
+      Eigen::Vector2d v = cfg_.goal_gain * to_goal;
+      if (v.norm() > task_speed_mps_) v *= task_speed_mps_ / v.norm();
+      out.mission_velocity = Eigen::Vector3d(v.x(), v.y(), 0.0);
       break;
+    }
     case Phase::kMove:
       out.mission_velocity = move_velocity_;
       out.busy = true;

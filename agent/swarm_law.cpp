@@ -155,7 +155,23 @@ LawTerms evaluate_law(const LawInput& in, const AgentConfig& c) {
     }
   }
 
-  Eigen::Vector3d v = t.obstacle + other;
+  if (in.obstacle_avoidance_enabled && !t.safety_active && c.sensor_function.slide_gain > 0) {
+    Eigen::Vector2d n = t.obstacle.head<2>();
+    const Eigen::Vector2d r = other.head<2>();
+    const double n_norm = n.norm();
+    if (n_norm > 1e-6) {
+      n /= n_norm;
+      const double into = -r.dot(n);  // how hard the other terms push toward the obstacle
+      if (into > 0) {
+        Eigen::Vector2d tangent(-n.y(), n.x());
+        const double side = r.dot(tangent);
+        if (side < -1e-3 * r.norm()) tangent = -tangent;
+        t.slide.head<2>() = c.sensor_function.slide_gain * into * tangent;
+      }
+    }
+  }
+
+  Eigen::Vector3d v = t.obstacle + other + t.slide;
   if (in.altitude_hold) {
     const double correction = std::clamp(c.altitude_gain * (in.altitude_target_m - in.p_world.z()),
                                          -c.landing_speed_mps, c.takeoff_speed_mps);

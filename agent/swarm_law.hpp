@@ -99,6 +99,7 @@ struct LawTerms {
   Eigen::Vector3d swarm{0, 0, 0};     ///< C (m/s), zero when disabled
   Eigen::Vector3d obstacle{0, 0, 0};  ///< C_s (m/s), as used (raised when safety is active)
   Eigen::Vector3d velocity{0, 0, 0};  ///< the command (m/s), limited
+  Eigen::Vector3d slide{0, 0, 0};     ///< m/s along the obstacle surface (slide_gain)
   bool safety_active = false;         ///< a ray hit closer than safety_distance_m
 };
 
@@ -107,6 +108,10 @@ struct LawTerms {
 ///    with u the unit horizontal direction away from those close hits, the
 ///    other terms (C + V_mission) lose any horizontal component along -u and
 ///    C_s becomes max_speed_mps * u, so the result always moves away (V.u > 0);
+///  - slide (sensor_function.slide_gain > 0): when C_s opposes the other
+///    terms horizontally, their blocked part |(C + V_mission).n| is redirected
+///    along the surface tangent (the side the other terms lean to; left when
+///    dead centre), times slide_gain;
 ///  - altitude hold: V.z = V_mission.z + clamp(altitude_gain * (target - z),
 ///    -landing_speed_mps, +takeoff_speed_mps), replacing the vertical parts of C;
 ///  - limits: horizontal speed, then total speed, to max_speed_mps, keeping direction.

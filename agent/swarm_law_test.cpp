@@ -378,3 +378,40 @@ TEST(SwarmCondition, SixScatteredDronesGatherWithinDefaultEpsilonWithoutCrowding
   EXPECT_NEAR(dmax, 1.53 * c.inter_distance_m, 0.1);
   EXPECT_LT(dmax, eps - 1.0);
 }
+
+// ---- sliding round an obstacle ------------------------------------------------------------
+
+TEST(ControlVelocity, SlidesRoundAPillarDeadAheadInsteadOfStalling) {
+  AgentConfig cfg;
+  cfg.altitude_hold = false;
+  // One pillar 2.5 m dead ahead of a drone flying north: the thesis's Eq. 3.3
+  // pushes straight back, a local minimum where forward push and repulsion cancel.
+  const std::vector<std::pair<Eigen::Vector2d, double>> pillars = {{{0, 3.5}, 1.0}};
+  const auto q = yaw(kPi / 2);
+  const Vector3d p(0, 0, 2);
+  Scan sc = scan(p, q, pillars);
+  LawInput in;
+  in.p_world = p;
+  in.q_world_body = q;
+  in.ray_range_m = sc.range;
+  in.ray_hit = sc.hit;
+  in.ray_yaw_body_rad = sc.yaw;
+  in.mission_velocity = Vector3d(0, 0.8, 0);
+  in.swarm_enabled = false;
+  in.altitude_hold = false;
+
+  cfg.sensor_function.slide_gain = 0.0;  // the thesis's law
+  LawTerms pure = evaluate_law(in, cfg);
+  EXPECT_NEAR(pure.velocity.x(), 0.0, 1e-6) << "no sideways way out: the drone stalls";
+
+  cfg.sensor_function.slide_gain = 1.0;
+  LawTerms slid = evaluate_law(in, cfg);
+  EXPECT_GT(std::abs(slid.velocity.x()), 0.3) << "the blocked push goes round the pillar";
+  EXPECT_LT(slid.velocity.y(), in.mission_velocity.y()) << "and does not drive into it harder";
+
+  // Off-centre to the east, it goes round on the east side (the way it leans).
+  in.mission_velocity = Vector3d(0.3, 0.8, 0);
+  EXPECT_GT(evaluate_law(in, cfg).slide.x(), 0.0);
+  in.mission_velocity = Vector3d(-0.3, 0.8, 0);
+  EXPECT_LT(evaluate_law(in, cfg).slide.x(), 0.0);
+}

@@ -125,6 +125,9 @@ struct DdsCommander::Impl {
       const auto& got = acks[s];
       for (int id : expect)
         if (!got.count(id)) return false;
+      if (c.target < 0)  // an agent heard only now must answer too
+        for (int id : online_locked())
+          if (!got.count(id)) return false;
       return true;
     };
     // One retry with the same seq after a third of the timeout: agents that
@@ -136,6 +139,11 @@ struct DdsCommander::Impl {
       cv.wait_for(lock, std::chrono::duration<double>(cfg.ack_timeout_s * 2 / 3), all_in);
     }
     const auto& got = acks[s];
+    // Drones whose heartbeat arrived while we waited, or that answered anyway, count too.
+    if (c.target < 0) {
+      for (int id : online_locked()) expect.insert(id);
+      for (const auto& [id, a] : got) expect.insert(id);
+    }
     std::vector<int> missing;
     std::string rejected;
     int accepted = 0;

@@ -106,6 +106,8 @@ int main(int argc, char** argv) {
     task->add_flag("--takeoff", fly, "wait for every agent, take off first, then run the task");
     task->add_option("--csv", csv, "append the result to this CSV");
     auto* status = app.add_subcommand("status", "print the swarm's status");
+    bool status_drones = false;
+    status->add_flag("--drones", status_drones, "also print every drone and the pairwise distances");
     auto* trace = app.add_subcommand("trace", "write every drone's state to CSV until Ctrl-C or --duration");
     std::string trace_out;
     int trace_every = 5;
@@ -170,6 +172,14 @@ int main(int argc, char** argv) {
     }
     if (*status) {
       std::printf("%s\n", format_status(gs.status()).c_str());
+      if (status_drones) {
+        auto snap = snapshot(file.dds, 3.0);
+        if (!snap) {
+          std::fprintf(stderr, "ddswarm-gs: error: no swarm state received within 3 s\n");
+          return 1;
+        }
+        std::printf("%s", snap->table().c_str());
+      }
       return 0;
     }
     if (*takeoff) {

@@ -1,10 +1,16 @@
 #include "ground_station/trace.hpp"
 
+#include <fmt/format.h>
+
 #include <atomic>
+#include <condition_variable>
+#include <limits>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
 
+#include "common/convert.hpp"
+#include "common/mission.hpp"
 #include "common/participant.hpp"
 
 namespace ddswarm::gs {
@@ -42,5 +48,69 @@ SwarmTrace::SwarmTrace(const DdsConfig& dds, const std::string& path, int every)
     : impl_(std::make_unique<Impl>(dds, path, every)) {}
 SwarmTrace::~SwarmTrace() = default;
 long SwarmTrace::rows() const { return impl_->rows; }
+
+std::string SwarmSnapshot::table() const {
+  std::string out = fmt::format("tick {} (sim {:.2f} s), {} drones\n", tick, sim_time_s, drones.size());
+  out += fmt::format("{:>5} {:>9} {:>9} {:>7} {:>7} {:>9} {:>5}  {:<9} {}\n", "drone", "x m", "y m",
+                     "z m", "m/s", "nearest m", "coll", "phase", "flags");
+  for (const auto& d : drones)
+    out += fmt::format("{:>5} {:>9.2f} {:>9.2f} {:>7.2f} {:>7.2f} {:>9.2f} {:>5}  {:<9} {}\n", d.id, d.x,
+                       d.y, d.z, d.speed_mps, d.nearest_peer_m, d.collisions, d.phase, d.flags);
+  out += fmt::format("pairwise distance: min {:.2f} m, max {:.2f} m\n", min_pair_m, max_pair_m);
+  return out;
+}
+
+std::optional<SwarmSnapshot> snapshot(const DdsConfig& dds, double timeout_s) {
+  std::mutex mu;
+  std::condition_variable cv;
+  std::optional<msg::SwarmState> got;
+  Participant p(dds, "ddswarm-gs-status");
+  p.reader<msg::SwarmState>([&](const msg::SwarmState& s, const fdds::SampleInfo&) {
+    std::lock_guard<std::mutex> lock(mu);
+    if (!got) got = s;
+    cv.notify_all();
+  });
+  std::unique_lock<std::mutex> lock(mu);
+  cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return got.has_value(); });
+  if (!got) return std::nullopt;
+  SwarmSnapshot snap;
+  snap.tick = got->tick();
+  snap.sim_time_s = got->sim_time_s();
+  std::vector<Eigen::Vector3d> pos;
+  for (const auto& d : got->drones()) pos.push_back(from_msg(d.position()));
+  snap.min_pair_m = pos.size() > 1 ? std::numeric_limits<double>::infinity() : 0;
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    const auto& d = got->drones()[i];
+    DroneRow r;
+    r.id = d.drone_id();
+    r.x = pos[i].x();
+    r.y = pos[i].y();
+    r.z = pos[i].z();
+    r.speed_mps = from_msg(d.velocity()).norm();
+    r.nearest_peer_m = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < pos.size(); ++j) {
+      if (j == i) continue;
+      double dist = (pos[i] - pos[j]).norm();
+      r.nearest_peer_m = std::min(r.nearest_peer_m, dist);
+      if (j > i) {
+        snap.min_pair_m = std::min(snap.min_pair_m, dist);
+        snap.max_pair_m = std::max(snap.max_pair_m, dist);
+      }
+    }
+    if (pos.size() < 2) r.nearest_peer_m = 0;
+    r.collisions = static_cast<int>(d.collisions_obstacle() + d.collisions_drone() + d.collisions_ground());
+    r.phase = to_string(static_cast<Phase>(d.phase()));
+    auto flag = [&](std::uint16_t bit, const char* name) {
+      if (d.flags() & bit) r.flags += (r.flags.empty() ? "" : ",") + std::string(name);
+    };
+    flag(msg::DRONE_AIRBORNE, "airborne");
+    flag(msg::DRONE_FAILSAFE, "failsafe");
+    flag(msg::DRONE_OUT_OF_BOUNDS, "out-of-bounds");
+    flag(msg::DRONE_PAST_FINISH, "past-finish");
+    if (!(d.flags() & msg::DRONE_AGENT_LIVE)) r.flags += (r.flags.empty() ? "" : ",") + std::string("no-agent");
+    snap.drones.push_back(r);
+  }
+  return snap;
+}
 
 }  // namespace ddswarm::gs

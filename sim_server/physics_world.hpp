@@ -1,0 +1,189 @@
+#pragma once
+// The simulated world: every drone, the ground and the obstacles, stepped by
+// Bullet. This is the one class that touches Bullet; the rest of the server
+// sees Eigen states, rotor commands, contact events and ray ranges.
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "common/scene.hpp"
+#include "sim_server/quadrotor.hpp"
+
+class btDefaultCollisionConfiguration;
+class btCollisionDispatcher;
+class btDbvtBroadphase;
+class btSequentialImpulseConstraintSolver;
+class btDiscreteDynamicsWorld;
+class btCollisionObject;
+class btCollisionShape;
+class btRigidBody;
+
+namespace ddswarm::sim {
+
+enum class ContactKind : std::uint8_t { kObstacle, kDrone, kGround };
+
+/// A contact that began during a step.
+struct ContactEvent {
+  int drone = 0;  ///< drone id (for drone-drone contacts, the lower id)
+  ContactKind kind = ContactKind::kGround;
+  /// kDrone: the other (higher) drone id; kObstacle: obstacle index, scene
+  /// cylinders first, then boxes (cylinders.size() + box index); kGround: -1.
+  int other = -1;
+  Eigen::Vector3d where_world{0, 0, 0};  ///< m, a contact point, ENU
+};
+
+/// How cast_rays finds what a ray hits. kCulled and kBruteForce intersect
+/// rays analytically with the exact shapes (ground plane, cylinders, boxes,
+/// drone cylinders at full attitude) and give identical ranges; kCulled asks
+/// Bullet's broadphase for what lies within range first and tests a ray only
+/// against objects whose bounding box it crosses.
+enum class RayCastMode : std::uint8_t {
+  kCulled,        ///< broadphase query, then per-ray AABB tests (default)
+  kBruteForce,    ///< every ray against every object (slow reference)
+  kWorldRayTest,  ///< Bullet's btCollisionWorld::rayTest (GJK ray cast) per ray, for
+                  ///< comparison only: ~10x slower, approximate on a drone's thin
+                  ///< disc at shallow incidence (most ranges agree to 5 mm)
+};
+
+class PhysicsWorld {
+ public:
+  /// Builds the ground plane at scene.ground_z_m, the scene's cylinders and
+  /// boxes, and one drone per start position, resting on the ground: the
+  /// bottom of its collision cylinder at start_positions[i] (whose z is
+  /// normally the ground height), level, heading start_yaw_rad. Contacts that
+  /// exist at construction (drones resting on the ground) are not reported.
+  /// Throws std::invalid_argument for 2^20 drones or more.
+  PhysicsWorld(const SceneConfig& scene, const QuadrotorParams& q,
+               const std::vector<Eigen::Vector3d>& start_positions, double start_yaw_rad);
+  ~PhysicsWorld();
+  PhysicsWorld(const PhysicsWorld&) = delete;
+  PhysicsWorld& operator=(const PhysicsWorld&) = delete;
+
+  /// Number of drones.
+  int size() const { return static_cast<int>(drones_.size()); }
+
+  /// Sets the rotor speed commands (rad/s, clamped to [omega_min, omega_max]);
+  /// the first-order motor lag is applied inside step(). Held until changed.
+  void set_rotor_commands(int drone, const std::array<double, 4>& omega_cmd_rad_s);
+
+  /// Advances one fixed step of dt seconds: motor lag, rotor thrust k_f w^2 at
+  /// the rotor hubs along body z, reaction torques -+k_m w^2 about body z,
+  /// body drag, gravity, contacts. Then records the contacts that began.
+  /// Does not allocate once the contact buffers have grown.
+  void step(double dt);
+
+  /// s, simulated time (sum of the dt passed to step()).
+  double time_s() const { return time_s_; }
+
+  RigidState state(int drone) const;
+  /// rad/s, actual (lagged) rotor speeds.
+  std::array<double, 4> rotor_speeds(int drone) const;
+
+  /// Teleports a drone: bottom of its collision cylinder at p, level, heading
+  /// yaw, at rest, rotors stopped (commands cleared). Its contacts end; the
+  /// contacts it has at the new place (e.g. the ground) are not reported.
+  void reset_drone(int drone, const Eigen::Vector3d& p, double yaw_rad);
+
+  /// A pair is in contact while some contact point of theirs is within 5 mm;
+  /// the contact ends once the pair has not touched for this long (s), so a
+  /// bounce within a push is one contact, not several.
+  static constexpr double kContactReleaseS = 0.5;
+
+  /// Contact events since the last call, in step order: one per contact that
+  /// begins. A pair in contact over many steps counts once; it counts again
+  /// only after kContactReleaseS apart.
+  std::vector<ContactEvent> take_contact_events();
+
+  /// True while the drone touches the ground plane (as of the last step).
+  bool touching_ground(int drone) const { return touching_ground_[drone] != 0; }
+
+  /// Casts the drone's distance sensors from its body centre. Ray k points at
+  /// body yaw cfg.yaw_offset_rad + 2 pi k / cfg.count in the body x-y plane,
+  /// turned with the full body attitude. A ray never hits its own drone; it
+  /// hits other drones, obstacles and the ground. On return both vectors have
+  /// cfg.count entries: hit[k] = 1 and range_m[k] = true distance + N(0,
+  /// sigma) clamped to [min_range_m, max_range_m] when something is within
+  /// max_range_m; otherwise hit[k] = 0 and range_m[k] = max_range_m. A ray
+  /// starting inside an object measures 0 (then min_range_m). Noise is drawn
+  /// from rng once per hit ray, in ray order. Concurrent calls are safe in the
+  /// default mode (kCulled), never concurrently with step().
+  void cast_rays(int drone, const SensorConfig& cfg, std::mt19937_64& rng,
+                 std::vector<float>& range_m, std::vector<std::uint8_t>& hit) const;
+
+  void set_ray_cast_mode(RayCastMode mode) { ray_mode_ = mode; }
+
+  const QuadrotorParams& params() const { return params_; }
+
+ private:
+  struct Drone {
+    std::unique_ptr<btRigidBody> body;
+    std::array<double, 4> omega_cmd{};
+    std::array<double, 4> omega{};
+  };
+  /// A pair touching in this step's manifolds.
+  struct PairContact {
+    std::uint64_t key;
+    Eigen::Vector3d where_world;
+  };
+  /// A pair in contact, and when it last touched.
+  struct ContactState {
+    std::uint64_t key;
+    double last_touch_s;
+  };
+
+  /// Exact geometry of an obstacle, for ray casts.
+  struct ObstacleShape {
+    Eigen::Vector3d center;
+    Eigen::Vector3d half;  ///< cylinder: (r, r, h/2); box: half sizes
+    double cos_yaw, sin_yaw;
+    bool box;
+  };
+  /// A drone or obstacle a ray may hit, with its exact AABB.
+  struct RayTarget {
+    bool drone;
+    int index;               ///< drone id or obstacle index
+    Eigen::Vector3d center;  ///< world
+    Eigen::Matrix3d rot;     ///< drones: body -> world
+    Eigen::Vector3d aabb_min, aabb_max;
+  };
+
+  void ray_target(const btCollisionObject* o, RayTarget& t) const;
+  double ray_distance(const RayTarget& t, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+                      double t_max) const;
+  void add_static(std::unique_ptr<btCollisionShape> shape, const Eigen::Vector3d& origin,
+                  double yaw_rad, ContactKind kind, int index);
+  void place(btRigidBody& body, const Eigen::Vector3d& bottom, double yaw_rad) const;
+  void update_contacts(bool report);
+
+  QuadrotorParams params_;
+  double ground_z_m_;
+  // Rotor model, cached from params_.
+  double k_f_, k_m_, omega_min_, omega_max_;
+  std::array<Eigen::Vector3d, 4> rotor_pos_;
+
+  // Bullet objects, in construction order (destroyed in reverse).
+  std::unique_ptr<btDefaultCollisionConfiguration> collision_config_;
+  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btDbvtBroadphase> broadphase_;
+  std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
+  std::unique_ptr<btDiscreteDynamicsWorld> world_;
+  std::vector<std::unique_ptr<btCollisionShape>> static_shapes_;  ///< ground, cylinders, boxes
+  std::unique_ptr<btCollisionShape> drone_shape_;                 ///< shared by all drones
+  std::vector<std::unique_ptr<btRigidBody>> statics_;             ///< ground, then obstacles
+  std::vector<Drone> drones_;
+  std::vector<ObstacleShape> obstacle_shapes_;  ///< by obstacle index
+
+  double time_s_ = 0.0;
+  RayCastMode ray_mode_ = RayCastMode::kCulled;
+  std::vector<PairContact> touching_;     ///< scratch: pairs touching this step
+  std::vector<ContactState> in_contact_;  ///< pairs in contact, sorted by key
+  std::vector<ContactState> in_contact_next_;
+  std::vector<ContactEvent> events_;
+  std::vector<std::uint8_t> touching_ground_;  ///< per drone, this step
+  std::vector<std::uint8_t> quiet_;            ///< per drone: adopt contacts without events
+};
+
+}  // namespace ddswarm::sim

@@ -1,0 +1,117 @@
+#pragma once
+// The simulated vehicle: a quadrotor in X configuration and its distance
+// sensors, described by plain config structs.
+//
+// Body frame FLU (x forward, y left, z up); world frame ENU; SI units.
+// Rotor numbering follows PX4's quad-x, seen from above (x up the page,
+// y to the left):
+//
+//      2 (CW)     0 (CCW)      front
+//      1 (CCW)    3 (CW)       rear
+//
+//   rotor 0 front-right CCW, 1 rear-left CCW, 2 front-left CW, 3 rear-right CW.
+// A CCW rotor (spin vector +z) pushes the body with reaction torque -k_m w^2
+// about body z; a CW rotor with +k_m w^2.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+
+#include "common/yaml_section.hpp"
+
+namespace ddswarm::sim {
+
+/// Standard gravity (m/s^2), used by the physics world and the controller.
+inline constexpr double kGravityMps2 = 9.80665;
+
+/// Rigid-body state of one drone.
+struct RigidState {
+  Eigen::Vector3d p_world{0, 0, 0};  ///< m, body centre (centre of mass), ENU
+  Eigen::Vector3d v_world{0, 0, 0};  ///< m/s, ENU
+  Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();  ///< body FLU -> world ENU
+  Eigen::Vector3d w_body{0, 0, 0};  ///< rad/s, angular velocity in body axes
+};
+
+/// rad, heading of the body x axis (yaw about world z), in (-pi, pi].
+double yaw_of(const Eigen::Quaterniond& q_world_body);
+
+/// Collective thrust along body +z and torque about the body axes.
+struct Wrench {
+  double thrust_n = 0.0;                    ///< N, along body +z
+  Eigen::Vector3d torque_body_nm{0, 0, 0};  ///< N m, body FLU axes
+};
+
+/// Physical description of the quadrotor.
+///
+/// Defaults are AirSim's "generic quadrotor" (AirSim MultiRotorParams::
+/// setupFrameGenericQuad and RotorParams), the simulator the thesis used:
+/// 1 kg, 0.2275 m arms, a 0.18 x 0.11 x 0.04 m body box plus four 0.055 kg
+/// motor assemblies for the inertia, propellers with C_T = 0.109919,
+/// C_P = 0.040164, D = 0.2286 m at 6396.667 RPM in air of 1.225 kg/m^3, a
+/// 5 ms motor filter, and AirSim's face-area drag model reduced to one
+/// quadratic coefficient per body axis.
+struct QuadrotorParams {
+  double mass_kg = 1.0;                          ///< kg, total mass, > 0
+  double arm_length_m = 0.2275;                  ///< m, centre to rotor axis, > 0
+  Eigen::Vector3d body_box_m{0.18, 0.11, 0.04};  ///< m, central box x, y, z, each > 0
+  double motor_mass_kg = 0.055;  ///< kg per motor assembly (point mass at the arm tip), >= 0
+  double rotor_z_m = 0.025;      ///< m, rotor plane above the centre (inertia only), >= 0
+  /// kg m^2, [Ixx, Iyy, Izz] override; all zero (default) computes the inertia
+  /// from body_box_m and the motor point masses (AirSim's formula).
+  Eigen::Vector3d inertia_kgm2{0, 0, 0};
+
+  double thrust_coeff = 0.109919;   ///< C_T, thrust = C_T rho n^2 D^4 (n in rev/s), > 0
+  double power_coeff = 0.040164;    ///< C_P, torque = C_P rho n^2 D^5 / (2 pi), > 0
+  double prop_diameter_m = 0.2286;  ///< m, > 0
+  double air_density_kgm3 = 1.225;  ///< kg/m^3, > 0
+  double max_rpm = 6396.667;        ///< rev/min at full command (omega_max ~ 669.9 rad/s), > 0
+  double omega_min_rad_s = 0.0;     ///< rad/s, lowest rotor speed, in [0, omega_max)
+  double motor_tau_s = 0.005;       ///< s, first-order rotor speed lag, >= 0 (0 = instant)
+
+  /// N/(m/s)^2 per body axis: F = -c v|v| (AirSim: 0.325/2 * rho * exposed
+  /// area of the box faces plus propellers, per axis).
+  Eigen::Vector3d drag_quadratic_body{0.0066, 0.0072, 0.1347};
+  double drag_linear_n_per_mps = 0.0;       ///< N/(m/s), extra linear drag on each axis, >= 0
+  double angular_drag_nm_per_rad_s = 5e-4;  ///< N m/(rad/s), body rate damping, >= 0
+
+  double collision_radius_m = 0.3;        ///< m, collision cylinder radius (covers props), > 0
+  double collision_half_height_m = 0.05;  ///< m, collision cylinder half height, > 0
+
+  void validate() const;  ///< throws FieldError("quadrotor.…")
+
+  /// rad/s, rotor speed at full command.
+  double omega_max_rad_s() const;
+  /// N/(rad/s)^2: thrust = k_f omega^2.
+  double k_f() const;
+  /// N m/(rad/s)^2: reaction torque = k_m omega^2.
+  double k_m() const;
+  /// N, thrust of one rotor at omega_max.
+  double max_rotor_thrust_n() const;
+  /// rad/s, rotor speed at which the four rotors carry the weight.
+  double hover_omega() const;
+  /// kg m^2, diagonal inertia [Ixx, Iyy, Izz] (override or computed).
+  Eigen::Vector3d inertia() const;
+  /// m, rotor i's hub in the body frame (z = 0: the thrust line passes the
+  /// centre plane; rotor_z_m only enters the inertia).
+  Eigen::Vector3d rotor_position_body(int i) const;
+  /// +1 for a CCW rotor (0, 1), -1 for a CW rotor (2, 3).
+  static int rotor_spin(int i) { return i < 2 ? 1 : -1; }
+  /// Forward rotor model: the wrench produced by rotor speeds (rad/s).
+  Wrench rotor_wrench(const std::array<double, 4>& omega_rad_s) const;
+};
+
+void load(YamlSection s, QuadrotorParams& c);
+
+/// The ring of distance sensors on every drone (the thesis's 8 rangefinders).
+struct SensorConfig {
+  int count = 8;                ///< rays, evenly spaced in the body x-y plane, in [1, 64]
+  double max_range_m = 4.0;     ///< m, > min_range_m
+  double min_range_m = 0.05;    ///< m, > 0; measured ranges are clamped to it
+  double noise_sigma_m = 0.02;  ///< m, Gaussian range noise standard deviation, >= 0
+  double yaw_offset_rad = 0.0;  ///< rad, body yaw of ray 0, in [-2pi, 2pi]
+
+  void validate() const;  ///< throws FieldError("sensors.…")
+};
+
+void load(YamlSection s, SensorConfig& c);
+
+}  // namespace ddswarm::sim
