@@ -90,11 +90,15 @@ struct DdsCommander::Impl {
     });
   }
 
+  /// Agents heard recently, plus those the server (the authority on
+  /// liveness) reports live in its latest status.
   std::set<int> online_locked() const {
     std::set<int> out;
     double now = wall_seconds();
     for (const auto& [id, s] : agents)
       if (now - s.wall <= cfg.online_window_s) out.insert(id);
+    if (sim && now - sim_wall <= cfg.online_window_s)
+      for (auto id : sim->live_agents()) out.insert(id);
     return out;
   }
 
@@ -203,6 +207,17 @@ bool DdsCommander::wait_airborne(int count, double timeout_s) {
   std::unique_lock<std::mutex> lock(impl_->mu);
   return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
     return stop_requested() || (impl_->sim && impl_->sim->airborne() == count);
+  }) && !stop_requested();
+}
+
+bool DdsCommander::wait_takeoff_done(int count, double timeout_s) {
+  std::unique_lock<std::mutex> lock(impl_->mu);
+  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+    if (stop_requested()) return true;
+    if (!impl_->sim || impl_->sim->airborne() < count) return false;
+    for (int id : impl_->online_locked())
+      if (impl_->agents.count(id) && impl_->agents.at(id).phase == Phase::kTakeoff) return false;
+    return true;
   }) && !stop_requested();
 }
 

@@ -40,6 +40,9 @@ class DdsCommander final : public Commander {
   bool wait_sim_time(double t, double timeout_s);
   /// Waits until `airborne` drones are airborne (or on the ground when 0).
   bool wait_airborne(int count, double timeout_s);
+  /// Waits until `count` drones are airborne and no online agent is still
+  /// taking off (all reached their altitude). False on timeout.
+  bool wait_takeoff_done(int count, double timeout_s);
 
   CommandResult takeoff(double altitude_m) override;
   CommandResult move(const Eigen::Vector3d& v_enu, double duration_s) override;

@@ -29,7 +29,7 @@ TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
     fail.reason = "takeoff: " + r.message;
     return fail;
   }
-  if (!gs.wait_airborne(drones, 120.0)) {
+  if (!gs.wait_takeoff_done(drones, 120.0)) {
     fail.reason = "not every drone became airborne";
     return fail;
   }

@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     double altitude = 0;
     bool wait_flag = false;
     takeoff->add_option("--altitude", altitude, "m above ground (0 = agents' default)")->check(CLI::Range(0.0, 1000.0));
-    takeoff->add_flag("--wait", wait_flag, "wait until every drone is airborne");
+    takeoff->add_flag("--wait", wait_flag, "wait until every drone has reached its altitude");
     auto* move = app.add_subcommand("move", "move the swarm by velocity for a time");
     double north = 0, east = 0, up = 0, time_s = 0;
     move->add_option("--north", north, "m/s")->check(CLI::Range(-50.0, 50.0));
@@ -184,7 +184,7 @@ int main(int argc, char** argv) {
     }
     if (*takeoff) {
       int rc = report(gs.takeoff(altitude));
-      if (rc == 0 && wait_flag && !gs.wait_airborne(gs.status().drones_total, 120)) {
+      if (rc == 0 && wait_flag && !gs.wait_takeoff_done(gs.status().drones_online, 120)) {
         std::fprintf(stderr, "ddswarm-gs: error: not every drone became airborne within 120 s\n");
         return 1;
       }

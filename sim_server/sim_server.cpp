@@ -528,9 +528,9 @@ struct SimServer::Impl {
     {
       std::lock_guard<std::mutex> lock(mu);
       s = counters;
-      int live = 0;
-      for (const auto& sl : slots) live += sl.live;
-      s.agents_live(static_cast<std::uint16_t>(live));
+      for (int i = 0; i < n; ++i)
+        if (slots[i].live) s.live_agents().push_back(static_cast<std::uint16_t>(i));
+      s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
     }
     s.tick(tick);
     s.sim_time_s(sim_time());
