@@ -46,6 +46,8 @@ struct DdsCommander::Impl {
   std::optional<msg::SimStatus> sim;
   double sim_wall = -1e9;
   std::optional<msg::TaskStatus> task;
+  std::uint64_t scene_seed = 0;
+  std::string scene_name;
   std::map<int, AgentSeen> agents;
   std::map<std::uint32_t, std::map<int, msg::MissionAck>> acks;  // seq -> drone -> ack
   std::uint32_t seq = 0;
@@ -68,6 +70,11 @@ struct DdsCommander::Impl {
       sim = s;
       sim_wall = wall_seconds();
       cv.notify_all();
+    });
+    dds.reader<msg::Scene>([this](const msg::Scene& sc, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(mu);
+      scene_seed = sc.seed();
+      scene_name = sc.name().to_string();
     });
     dds.reader<msg::TaskStatus>([this](const msg::TaskStatus& t, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
@@ -306,6 +313,8 @@ std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_p
       o.collisions_ground = static_cast<int>(t.collisions_ground());
       o.min_inter_drone_m = t.min_inter_drone_m();
       o.min_clearance_m = t.min_clearance_m();
+      o.seed = I.scene_seed;
+      o.scenario = I.scene_name;
       break;
     }
     if (stop_requested()) {

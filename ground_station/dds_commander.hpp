@@ -2,6 +2,7 @@
 // The ground station's link to the swarm over DDS: sends mission commands,
 // gathers every live agent's acknowledgement, follows status and the task.
 #include <memory>
+#include <cstdint>
 #include <optional>
 
 #include "common/dds_config.hpp"
@@ -22,6 +23,8 @@ struct TaskOutcome {
   int collisions_obstacle = 0, collisions_drone = 0, collisions_ground = 0;
   double min_inter_drone_m = 0;
   double min_clearance_m = 0;
+  std::uint64_t seed = 0;     ///< the scenario's seed (from the server's Scene)
+  std::string scenario;       ///< the scenario's name
   std::string line() const;  ///< the one-line result
 };
 

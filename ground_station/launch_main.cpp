@@ -181,8 +181,9 @@ int main(int argc, char** argv) {
       }
     }
     if (died && stop_on_death) std::cerr << "ddswarm-launch: a process died; stopping everything\n";
+    // A clean shutdown is exit code 0 after our SIGTERM; anything else is worth saying.
     for (const auto& e : procs.stop_all(3.0))
-      if (e.signal != 0 && e.signal != SIGTERM && e.signal != SIGINT)
+      if ((e.signal != 0 && e.signal != SIGTERM) || (e.signal == 0 && e.exit_code != 0))
         std::cerr << "ddswarm-launch: at shutdown " << e.describe() << "\n";
     std::cerr << "ddswarm-launch: all processes stopped\n";
     if (rc != 0) return 1;

@@ -29,7 +29,8 @@ int report(const CommandResult& r) {
 void append_result(const std::string& csv, const TaskOutcome& o, int drones) {
   if (csv.empty()) return;
   RunRecord rec;
-  rec.set_name = "cli";
+  rec.set_name = o.scenario.empty() ? "cli" : o.scenario;
+  rec.seed = o.seed;
   rec.drones = drones;
   rec.speed_mps = o.speed_mps;
   rec.ok = o.ok;

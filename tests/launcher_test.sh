@@ -32,4 +32,6 @@ wait_pid "$PID_launch2" 15; rc=$?
 sleep 0.5
 [ -z "$(children x)" ] || fail "children left behind after SIGINT: $(children x)"
 grep -q "all processes stopped" "$WORK/launch2.log" || fail "no shutdown report"
+# Every survivor exited cleanly (code 0) on SIGTERM.
+grep "at shutdown" "$WORK/launch2.log" && fail "a process did not shut down cleanly"
 echo PASS

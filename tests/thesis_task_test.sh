@@ -15,5 +15,7 @@ grep -q "task complete:" "$WORK/launch.log" || fail "no task result line"
 grep -q "collisions: obstacle 0, drone 0, ground 0" "$WORK/launch.log" || fail "collisions during the task"
 rows=$(($(wc -l <"$WORK/result.csv") - 1))
 [ "$rows" -eq 1 ] || fail "expected one CSV row, got $rows"
+head -1 "$WORK/result.csv" | grep -q "seed" || fail "CSV lacks the seed column"
+sed -n 2p "$WORK/result.csv" | grep -q "^thesis_course,0,1," || fail "CSV row lacks scenario name and seed: $(sed -n 2p "$WORK/result.csv")"
 echo "wall time $((SECONDS - started)) s"
 echo PASS
