@@ -127,6 +127,12 @@ struct AgentApp::Impl {
       scene = scene_from_msg(s);
       fsm = std::make_unique<MissionFsm>(id, cfg.agent, *scene);
       spdlog::info("drone {}: scene '{}' received", id, s.name().to_string());
+      const double reach = sensor_range_m(cfg.agent.sensor_function);
+      if (reach > s.sensor_max_range_m() + 1e-6)
+        spdlog::warn("drone {}: agent.sensor_function reacts up to {:.1f} m but the sensors "
+                     "(sensors.max_range_m) see only {:.1f} m: the reaction jumps when an obstacle "
+                     "comes into view",
+                     id, reach, s.sensor_max_range_m());
     });
     // Listen before speaking: refuse to fly a drone another agent already flies.
     wait_for_stop(std::chrono::duration<double>(cfg.duplicate_probe_s));

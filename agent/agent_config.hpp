@@ -69,7 +69,7 @@ struct AgentConfig {
   double task_speed_mps = 0.8;     ///< m/s, task speed when the command gives 0; (0, max_speed]
   double goal_gain = 0.3;         ///< 1/s, task gathering: pull toward the goal point, (0, 5]
   double teleop_timeout_s = 1.0;   ///< s (sim), leader's teleop velocity drops to 0 after this; > 0
-  double server_timeout_s = 1.0;   ///< s (wall), no server sample for this long -> failsafe; > 0
+  double server_timeout_s = 1.0;   ///< s (wall): no server sample this long = server lost (logged once, flagged in heartbeats); > 0
 
   void validate() const;  ///< throws FieldError("agent.…")
 };

@@ -2,6 +2,8 @@
 
 #include <CLI/CLI.hpp>
 #include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
 
 #include "common/yaml_section.hpp"
 
@@ -12,6 +14,19 @@ bool is_ipv4(const std::string& s) {
   return inet_pton(AF_INET, s.c_str(), &a) == 1;
 }
 std::string host_of(const std::string& s) { return s.substr(0, s.find(':')); }
+/// True when ip is assigned to one of this host's interfaces.
+bool is_local_address(const std::string& ip) {
+  in_addr want{};
+  if (inet_pton(AF_INET, ip.c_str(), &want) != 1) return false;
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return false;
+  bool found = false;
+  for (ifaddrs* a = list; a && !found; a = a->ifa_next)
+    if (a->ifa_addr && a->ifa_addr->sa_family == AF_INET)
+      found = reinterpret_cast<sockaddr_in*>(a->ifa_addr)->sin_addr.s_addr == want.s_addr;
+  freeifaddrs(list);
+  return found;
+}
 }  // namespace
 
 void load(YamlSection s, DdsConfig& c) {
@@ -46,9 +61,19 @@ void DdsConfig::validate() const {
     for (const auto& p : peers)
       if (!is_ipv4(host_of(p))) throw FieldError("dds.peers", p, "must be an IPv4 address");
   }
-  if (discovery == Discovery::kDiscoveryServer && !is_ipv4(host_of(discovery_server)))
-    throw FieldError("dds.discovery_server", discovery_server.empty() ? "(empty)" : discovery_server,
-                     "must be ip:port");
+  if (discovery == Discovery::kDiscoveryServer) {
+    if (!is_ipv4(host_of(discovery_server)))
+      throw FieldError("dds.discovery_server", discovery_server.empty() ? "(empty)" : discovery_server,
+                       "must be ip:port");
+    if (host_of(discovery_server) != "127.0.0.1" && interface_ip.empty())
+      throw FieldError("dds.interface_ip", "(empty)",
+                       "a discovery server on another host needs this host's address on that network "
+                       "(--dds-local-ip)");
+  }
+  // Fast DDS silently drops a whitelisted address this host does not have,
+  // which would leave the process unreachable without a word.
+  if (!interface_ip.empty() && discovery != Discovery::kLocalhost && !is_local_address(interface_ip))
+    throw FieldError("dds.interface_ip", interface_ip, "is not an address of this host");
 }
 
 void add_dds_options(CLI::App& app, DdsConfig& c) {
@@ -70,7 +95,8 @@ void add_dds_options(CLI::App& app, DdsConfig& c) {
          "opt in: unicast discovery to these peer IPv4 addresses (needs --dds-local-ip)")
       ->delimiter(',')
       ->group("Networking (default: this machine only)");
-  app.add_option("--dds-local-ip", c.interface_ip, "with --dds-peers: this host's address")
+  app.add_option("--dds-local-ip", c.interface_ip,
+                 "with --dds-peers or a remote --discovery-server: this host's address on that network")
       ->group("Networking (default: this machine only)");
   app.add_option_function<std::string>(
          "--discovery-server",

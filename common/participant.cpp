@@ -79,7 +79,9 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
       auto colon = cfg.discovery_server.find(':');
       std::string ip = cfg.discovery_server.substr(0, colon);
       uint32_t port = colon == std::string::npos ? 11811 : std::stoul(cfg.discovery_server.substr(colon + 1));
-      if (ip != kLoopback) udp->interfaceWhiteList.emplace_back(ip == "0.0.0.0" ? kLoopback : ip);
+      // Reach a server on another host through this host's own address on
+      // that network (the whitelist takes local addresses only).
+      if (!cfg.interface_ip.empty()) udp->interfaceWhiteList.emplace_back(cfg.interface_ip);
       eprosima::fastrtps::rtps::RemoteServerAttributes server;
       server.ReadguidPrefix("44.53.00.5f.45.50.52.4f.53.49.4d.41");  // fast-discovery-server -i 0
       server.metatrafficUnicastLocatorList.push_back(udp_locator(ip, port));

@@ -35,7 +35,7 @@ enum class Formation { kCluster, kGrid, kRandom, kExplicit };
 struct StartConfig {
   Formation formation = Formation::kCluster;
   Eigen::Vector2d center_xy{0, 0};           ///< m
-  double spacing_m = 2.0;                    ///< m between neighbours, > 0.7
+  double spacing_m = 2.0;                    ///< m between neighbours, >= 0.7
   double radius_m = 8.0;                     ///< m, disc radius for kRandom
   double yaw_rad = 0.0;                      ///< initial heading of every drone
   std::vector<Eigen::Vector3d> positions;    ///< kExplicit: one per drone (z = 0 on ground)

@@ -189,6 +189,11 @@ void YamlDocument::index(const YAML::Node& n, const std::string& prefix) {
   if (n.IsMap()) {
     for (auto it = n.begin(); it != n.end(); ++it) {
       std::string p = join(prefix, it->first.Scalar());
+      // yaml-cpp keeps both entries of a repeated key and reads the first:
+      // a silent surprise, so it is an error.
+      if (lines_.count(p))
+        throw ConfigError(file_ + ":" + std::to_string(it->first.Mark().line + 1) + ": " + p +
+                          ": duplicate key (first at line " + std::to_string(lines_[p]) + ")");
       lines_[p] = it->first.Mark().line + 1;
       index(it->second, p);
     }

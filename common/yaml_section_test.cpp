@@ -56,3 +56,8 @@ TEST(YamlSection, SyntaxErrorAndMissingFile) {
   EXPECT_NE(error_of("demo: [1, 2\n").find("x.yaml:"), std::string::npos);
   EXPECT_THROW(YamlDocument::load_file("/nonexistent/file.yaml"), ConfigError);
 }
+
+TEST(YamlSection, DuplicateKeyIsAnError) {
+  EXPECT_EQ(error_of("demo:\n  radius_m: 2\n  radius_m: 3\n"),
+            "x.yaml:3: demo.radius_m: duplicate key (first at line 2)");
+}

@@ -287,7 +287,7 @@ struct SimServer::Impl {
       referee.fail(std::string("aborted by ") + to_string(type) + " command");
     if (type == MissionType::kTask) {
       double dint = d_int > 0 ? d_int : (agent_d_int > 0 ? agent_d_int : 4.0);
-      double eps = m.epsilon_m() > 0 ? m.epsilon_m() : 2.5 * dint;
+      double eps = m.epsilon_m() > 0 ? m.epsilon_m() : default_epsilon(dint);
       referee.start(m.seq(), sim_time(), eps, m.value(), n);
     }
   }
