@@ -11,6 +11,7 @@
 #include <map>
 #include <set>
 
+#include "agent/comm_model.hpp"
 #include "agent/mission_fsm.hpp"
 #include "agent/peer_source.hpp"
 #include "agent/swarm_law.hpp"
@@ -23,6 +24,7 @@ namespace ddswarm::agent {
 void AgentAppConfig::validate() const {
   scenario.validate();
   agent.validate();
+  comm.validate();
   dds.validate();
   if (drone_id < 0 || drone_id >= scenario.drones)
     throw FieldError("--id", std::to_string(drone_id),
@@ -36,9 +38,11 @@ AgentAppConfig load_agent_config(const std::string& path) {
   doc.guard([&] {
     load(doc.section("scenario"), c.scenario);
     load(doc.section("agent"), c.agent);
+    load(doc.section("comm"), c.comm);
     load(doc.section("dds"), c.dds);
     c.scenario.validate();
     c.agent.validate();
+    c.comm.validate();
     c.dds.validate();
   });
   return c;
@@ -75,12 +79,15 @@ struct AgentApp::Impl {
   Writer<msg::VelocityCommand> w_cmd;
   Writer<msg::AgentStatus> w_status;
   Writer<msg::MissionAck> w_ack;
+  Writer<msg::Beacon> w_beacon;
 
   std::mutex mu;  // guards everything below (DDS callbacks run on Fast DDS threads)
   std::optional<SceneConfig> scene;
   std::unique_ptr<MissionFsm> fsm;
   TruthPeerSource truth;
+  std::unique_ptr<ModelledPeerSource> modelled;  // when comm asks for more than exact truth
   PeerSource* peers = &truth;
+  std::uint64_t fed_tick = ~0ULL;  // the tick whose truth and beacons the peer source has taken
   // (issuer, seq) -> the apply_tick it came with; oldest first for pruning.
   std::map<std::pair<std::uint64_t, std::uint32_t>, std::uint64_t> seen_missions;
   std::deque<std::pair<std::uint64_t, std::uint32_t>> seen_order;
@@ -94,6 +101,7 @@ struct AgentApp::Impl {
   std::uint64_t rival = 0;  // another instance heard on our id
   std::string rival_where;
   std::vector<PeerObservation> others;
+  std::vector<Eigen::Vector3d> ranged;
   std::vector<float> ranges, angles;
   std::vector<std::uint8_t> hits;
 
@@ -110,7 +118,8 @@ struct AgentApp::Impl {
         dds(cfg.dds, "ddswarm-agent-" + std::to_string(cfg.drone_id)),
         w_cmd(dds.writer<msg::VelocityCommand>()),
         w_status(dds.writer<msg::AgentStatus>()),
-        w_ack(dds.writer<msg::MissionAck>()) {
+        w_ack(dds.writer<msg::MissionAck>()),
+        w_beacon(dds.writer<msg::Beacon>()) {
     dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& s, const fdds::SampleInfo&) {
       if (s.drone_id() != id || s.agent_instance() == instance) return;
       std::lock_guard<std::mutex> lock(mu);
@@ -126,6 +135,19 @@ struct AgentApp::Impl {
       if (fsm) return;  // keep the mission across a server's re-announcement
       scene = scene_from_msg(s);
       fsm = std::make_unique<MissionFsm>(id, cfg.agent, *scene);
+      if (!cfg.comm.ideal()) {
+        const double tick_s = 1.0 / s.control_rate_hz();
+        const double ticks_per_beacon = s.control_rate_hz() / cfg.comm.beacon_rate_hz;
+        if (cfg.comm.source == PeerSourceType::kBeacons &&
+            std::abs(ticks_per_beacon - std::round(ticks_per_beacon)) > 1e-9)
+          spdlog::warn("drone {}: comm.beacon_rate_hz {} does not divide the control rate {} Hz; "
+                       "beacons go every {} ticks",
+                       id, cfg.comm.beacon_rate_hz, s.control_rate_hz(), std::round(ticks_per_beacon));
+        modelled = std::make_unique<ModelledPeerSource>(cfg.comm, s.seed(), id, tick_s);
+        peers = modelled.get();
+        spdlog::info("drone {}: peers from {} through the communication model", id,
+                     cfg.comm.source == PeerSourceType::kBeacons ? "beacons" : "truth");
+      }
       spdlog::info("drone {}: scene '{}' received", id, s.name().to_string());
       const double reach = sensor_range_m(cfg.agent.sensor_function);
       if (reach > s.sensor_max_range_m() + 1e-6)
@@ -241,14 +263,44 @@ struct AgentApp::Impl {
       }
       others.push_back({d.drone_id(), from_msg(d.position()), d.sim_time_s()});
     }
-    peers->on_truth(s.sim_time_s(), others);
+    // Each tick's truth and beacons go to the peer source once, even when the
+    // server re-sends the same tick while it waits.
+    const bool new_tick = s.tick() != fed_tick;
+    fed_tick = s.tick();
+    Eigen::Vector3d own_p = obs.p_world;
+    if (modelled) {
+      if (new_tick) {
+        modelled->set_tick(s.tick(), s.sim_time_s(), obs.p_world);
+        modelled->on_truth(s.sim_time_s(), others);
+        for (const auto& b : s.beacons()) {
+          if (b.drone_id() == id || b.drone_id() >= s.drones().size()) continue;
+          PeerMessage pm{b.drone_id(), b.tick(), b.stamp_s(), from_msg(b.position()), from_msg(b.true_position())};
+          modelled->on_beacon(pm, obs.p_world);
+        }
+      }
+      own_p = modelled->channel().noisy_own_position(obs.p_world, s.tick());
+    } else if (new_tick) {
+      peers->on_truth(s.sim_time_s(), others);
+    }
 
     MissionOutput out = fsm->step(obs);
     LawInput in;
-    in.p_world = obs.p_world;
+    in.p_world = own_p;
     in.q_world_body = from_msg(me.orientation()).normalized();
     const auto& peer_pos = peers->peers(s.sim_time_s());
-    in.peers_world = peer_pos;
+    ranged.clear();
+    if (modelled && cfg.comm.range_measurements) {
+      // A law that uses distances: direction from the position estimates,
+      // magnitude from the (noisy) UWB range to that peer.
+      for (const auto& h : modelled->heard(s.sim_time_s())) {
+        Eigen::Vector3d d = h.p_world - own_p;
+        auto r = modelled->range_to(h.id);
+        ranged.push_back(r && d.norm() > 1e-6 ? Eigen::Vector3d(own_p + d.normalized() * *r) : h.p_world);
+      }
+      in.peers_world = ranged;
+    } else {
+      in.peers_world = peer_pos;
+    }
     if (s.scans().size() > static_cast<std::size_t>(id)) {
       const auto& sc = s.scans()[id];
       std::size_t k = std::min({sc.range_m().size(), sc.hit().size(), sc.angle_body_rad().size()});
@@ -283,6 +335,17 @@ struct AgentApp::Impl {
     cmd.busy(out.busy);
     cmd.mission_seq(last_mission_seq);
     cmd.agent_instance(instance);
+    if (modelled && cfg.comm.source == PeerSourceType::kBeacons && modelled->beacon_due(s.tick())) {
+      PeerMessage b = modelled->beacon(s.tick(), s.sim_time_s(), obs.p_world);
+      msg::Beacon& m = cmd.own_beacon();
+      m.drone_id(static_cast<std::uint16_t>(id));
+      m.tick(s.tick());
+      m.stamp_s(b.stamp_s);
+      m.position(to_msg(b.reported_p));
+      m.velocity(me.velocity());
+      cmd.has_beacon(true);
+      if (new_tick) w_beacon.write(m);
+    }
     w_cmd.write(cmd);
     ++sent;
   }

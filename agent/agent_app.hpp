@@ -5,6 +5,7 @@
 #include <string>
 
 #include "agent/agent_config.hpp"
+#include "agent/comm_config.hpp"
 #include "common/dds_config.hpp"
 #include "common/scenario.hpp"
 
@@ -14,6 +15,7 @@ namespace ddswarm::agent {
 struct AgentAppConfig {
   ScenarioConfig scenario;
   AgentConfig agent;
+  CommConfig comm;
   DdsConfig dds;
   int drone_id = 0;              ///< which drone this agent flies, [0, scenario.drones)
   double duplicate_probe_s = 1.0;///< s wall: listen for another agent on this id before flying

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "agent/agent_app.hpp"
+#include "common/config_error.hpp"
 #include "common/process.hpp"
 
 int main(int argc, char** argv) {
@@ -28,6 +29,10 @@ int main(int argc, char** argv) {
     auto cfg = ddswarm::agent::load_agent_config(config);
     cfg.drone_id = id;
     if (drones) cfg.scenario.drones = *drones;
+    if (id < 0 || id >= cfg.scenario.drones)
+      throw ddswarm::ConfigError(config + ": --id = " + std::to_string(id) + ": must be in [0, " +
+                                 std::to_string(cfg.scenario.drones - 1) + "] (scenario.drones = " +
+                                 std::to_string(cfg.scenario.drones) + ")");
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
     cfg.validate();
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");

@@ -2,6 +2,8 @@
 
 #include <CLI/CLI.hpp>
 #include <arpa/inet.h>
+
+#include <cstdio>
 #include <ifaddrs.h>
 #include <netinet/in.h>
 
@@ -47,6 +49,11 @@ void load(YamlSection s, DdsConfig& c) {
 }
 
 void DdsConfig::validate() const {
+  if (FILE* f = std::fopen(profiles_file.c_str(), "r")) {
+    std::fclose(f);
+  } else {
+    throw FieldError("dds.profiles_file", profiles_file, "cannot read this file");
+  }
   check_range("dds.domain_id", domain_id, 0, 232);
   check_range("dds.participant_id", participant_id, -1, 119);
   if (!(lease_duration_s >= 1.0 && lease_duration_s <= 300.0))

@@ -1,6 +1,7 @@
 #pragma once
 // The one place that names every topic, its type and its QoS profile.
 #include "AgentStatusPubSubTypes.h"
+#include "BeaconPubSubTypes.h"
 #include "CollisionEventPubSubTypes.h"
 #include "DistanceScanPubSubTypes.h"
 #include "DroneStatePubSubTypes.h"
@@ -36,6 +37,7 @@ DDSWARM_TOPIC(VelocityCommand, "ddswarm/velocity_cmd", "command");
 DDSWARM_TOPIC(AgentStatus, "ddswarm/agent_status", "heartbeat");
 DDSWARM_TOPIC(MissionCommand, "ddswarm/mission", "mission");
 DDSWARM_TOPIC(MissionAck, "ddswarm/mission_ack", "events");
+DDSWARM_TOPIC(Beacon, "ddswarm/beacon", "state_keyed");
 
 #undef DDSWARM_TOPIC
 

@@ -1,6 +1,7 @@
 #include "common/yaml_section.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -106,9 +107,10 @@ T YamlSection::convert(const YAML::Node& n, const std::string& key) const {
       static_assert(sizeof(T) == 0, "unsupported config field type");
     }
   } catch (const YAML::Exception&) {
-    const char* what = std::is_same_v<T, bool>       ? "must be true or false"
-                       : std::is_integral_v<T>       ? "must be an integer"
-                                                     : "has the wrong type";
+    const char* what = std::is_same_v<T, bool>            ? "must be true or false"
+                       : std::is_integral_v<T>            ? "must be an integer"
+                       : std::is_floating_point_v<T>      ? "must be a number"
+                                                          : "has the wrong type";
     fail(n, key, scalar_text(n), what);
   }
 }
@@ -164,6 +166,9 @@ void YamlSection::finish() const {
 }
 
 YamlDocument YamlDocument::load_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ConfigError(path + ": is a directory, not a scenario file");
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open file");
   std::stringstream ss;
@@ -181,11 +186,15 @@ YamlDocument YamlDocument::parse(const std::string& text, const std::string& fil
   }
   if (d.root_ && !d.root_.IsNull() && !d.root_.IsMap())
     throw ConfigError(file + ":1: the document must be a mapping of sections");
-  d.index(d.root_, "");
+  d.index(d.root_, "", 0);
   return d;
 }
 
-void YamlDocument::index(const YAML::Node& n, const std::string& prefix) {
+void YamlDocument::index(const YAML::Node& n, const std::string& prefix, int depth) {
+  // An alias that refers to itself makes an endless tree; no config nests this deep.
+  if (depth > 32)
+    throw ConfigError(file_ + ":" + std::to_string(n.Mark().line + 1) + ": " + prefix.substr(0, 80) +
+                      "...: nested more than 32 levels (a recursive alias?)");
   if (n.IsMap()) {
     for (auto it = n.begin(); it != n.end(); ++it) {
       std::string p = join(prefix, it->first.Scalar());
@@ -195,13 +204,13 @@ void YamlDocument::index(const YAML::Node& n, const std::string& prefix) {
         throw ConfigError(file_ + ":" + std::to_string(it->first.Mark().line + 1) + ": " + p +
                           ": duplicate key (first at line " + std::to_string(lines_[p]) + ")");
       lines_[p] = it->first.Mark().line + 1;
-      index(it->second, p);
+      index(it->second, p, depth + 1);
     }
   } else if (n.IsSequence()) {
     for (std::size_t i = 0; i < n.size(); ++i) {
       std::string p = prefix + "[" + std::to_string(i) + "]";
       lines_[p] = n[i].Mark().line + 1;
-      index(n[i], p);
+      index(n[i], p, depth + 1);
     }
   }
 }

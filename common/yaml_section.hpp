@@ -99,7 +99,7 @@ class YamlDocument {
   void guard(const std::function<void()>& fn) const;
 
  private:
-  void index(const YAML::Node& n, const std::string& prefix);
+  void index(const YAML::Node& n, const std::string& prefix, int depth);
   YAML::Node root_;
   std::string file_;
   std::map<std::string, int> lines_;

@@ -52,6 +52,7 @@ struct DdsCommander::Impl {
   std::map<std::uint32_t, std::map<int, msg::MissionAck>> acks;  // seq -> drone -> ack
   std::uint32_t seq = 0;
   std::uint32_t task_seq = 0;
+  Reader<msg::MissionAck>* ack_reader = nullptr;
   std::optional<TaskOutcome> outcome;
 
   Impl(const GroundStationConfig& c, const DdsConfig& d)
@@ -89,7 +90,7 @@ struct DdsCommander::Impl {
       s.phase = static_cast<Phase>(a.phase());
       cv.notify_all();
     });
-    dds.reader<msg::MissionAck>([this](const msg::MissionAck& a, const fdds::SampleInfo&) {
+    ack_reader = &dds.reader<msg::MissionAck>([this](const msg::MissionAck& a, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
       if (a.issuer_instance() != instance) return;
       acks[a.seq()][a.drone_id()] = a;
@@ -189,18 +190,25 @@ bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
     if (stop_requested()) return true;
     if (!impl_->sim) return false;
     int want = count >= 0 ? count : impl_->sim->num_drones();
-    return static_cast<int>(impl_->online_locked().size()) >= want &&
-           impl_->w_mission.matched() > 0;
+    const int online = static_cast<int>(impl_->online_locked().size());
+    return online >= want && impl_->w_mission.matched() > 0 && impl_->ack_reader->matched() >= online;
   }) && !stop_requested();
 }
 
 bool DdsCommander::wait_for_server(double timeout_s) {
   std::unique_lock<std::mutex> lock(impl_->mu);
-  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+  const bool all_matched = impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
     if (stop_requested()) return true;
-    return impl_->sim && impl_->w_mission.matched() > 0 &&
-           static_cast<int>(impl_->online_locked().size()) >= impl_->sim->agents_live();
-  }) && !stop_requested();
+    // Acks written before an agent's writer matched our reader would be lost
+    // (volatile QoS), so every live agent must be matched before we speak.
+    const int online = static_cast<int>(impl_->online_locked().size());
+    return impl_->sim && impl_->w_mission.matched() > 0 && online >= impl_->sim->agents_live() &&
+           impl_->ack_reader->matched() >= online;
+  });
+  if (stop_requested()) return false;
+  // A frozen or unreachable agent never matches: go on once the server is
+  // there, and let the acknowledgements name whoever stays silent.
+  return all_matched || (impl_->sim && impl_->w_mission.matched() > 0);
 }
 
 bool DdsCommander::wait_sim_time(double t, double timeout_s) {

@@ -128,7 +128,7 @@ TEST(ExperimentConfig, BadValuesNameFieldAndLine) {
             "/exp/table.yaml:8: experiment.sets[0].set.agent.x = agent.x: conflicts with agent "
             "(set one or the other)");
   EXPECT_EQ(with("{ agent.inter_distance_m: 4 }", "{ a.b: 4, a.b: 5 }"),
-            "/exp/table.yaml:8: experiment.sets[0].set.a.b = 5: set twice");
+            "/exp/table.yaml:8: experiment.sets[0].set.a.b: duplicate key (first at line 8)");
   EXPECT_EQ(with("{ agent.inter_distance_m: 4 }", "[ 4 ]"),
             "/exp/table.yaml:8: experiment.sets[0].set: must be a mapping of key: value");
   std::string no_sets = kValid;

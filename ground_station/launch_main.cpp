@@ -5,12 +5,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <sstream>
 #include <thread>
 
 #include "common/process.hpp"
+#include "ground_station/experiment_config.hpp"
 #include "ground_station/gs_app.hpp"
 #include "ground_station/launcher.hpp"
 
@@ -90,11 +93,31 @@ int main(int argc, char** argv) {
     app.add_flag("--gs-interactive", gs_interactive, "open the ground-station console here");
     app.add_option("--log-dir", log_dir, "write each process's log to DIR/<name>.log instead of the terminal");
     app.add_option("--duration", duration_s, "stop everything after this many wall seconds");
+    std::vector<std::string> sets;
+    app.add_option("--set", sets,
+                   "override a scenario key for this run, e.g. --set comm.latency_s=0.3 (repeatable)");
     add_dds_options(app, dds_cli);
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
       return app.exit(e) == 0 ? 0 : 2;
+    }
+    if (!sets.empty()) {
+      // Derive the run's scenario once; every process then reads the same file.
+      std::map<std::string, YAML::Node> overrides;
+      for (const auto& kv : sets) {
+        auto eq = kv.find('=');
+        if (eq == std::string::npos || eq == 0)
+          throw FieldError("--set", kv, "must be key.path=value");
+        overrides[kv.substr(0, eq)] = YAML::Load(kv.substr(eq + 1));
+      }
+      YAML::Node derived = apply_overrides(YamlDocument::load_file(scenario).root(), overrides);
+      const std::string dir = log_dir.empty() ? std::filesystem::temp_directory_path().string() : log_dir;
+      std::filesystem::create_directories(dir);
+      const std::string path = dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
+      std::ofstream(path) << "# " << scenario << " with --set overrides\n" << YAML::Dump(derived) << "\n";
+      std::cerr << "ddswarm-launch: scenario with overrides written to " << path << "\n";
+      scenario = path;
     }
     auto file = load_gs_config(scenario);
     const int n = drones.value_or(file.drones);

@@ -98,7 +98,9 @@ struct SimServer::Impl {
   std::condition_variable cv;
   std::vector<Slot> slots;
   std::deque<msg::MissionCommand> pending_missions;
+  std::vector<msg::Beacon> pending_beacons;  // carried by accepted commands, forwarded next tick
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
+  std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   double agent_d_int = 0;
   msg::SimStatus counters;  // rejected_* and commands_* live here
@@ -203,6 +205,13 @@ struct SimServer::Impl {
     s.command_tick = c.tick();
     s.phase = static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
     s.busy = c.busy();
+    if (c.has_beacon() && c.own_beacon().drone_id() == c.drone_id() &&
+        std::isfinite(c.own_beacon().position().x()) && std::isfinite(c.own_beacon().position().y()) &&
+        std::isfinite(c.own_beacon().position().z())) {
+      // One beacon per drone per tick: a repeated answer replaces, never duplicates.
+      std::erase_if(pending_beacons, [&](const msg::Beacon& b) { return b.drone_id() == c.drone_id(); });
+      pending_beacons.push_back(c.own_beacon());
+    }
     if (c.tick() == published_tick) s.answered = true;
     cv.notify_all();
   }
@@ -281,6 +290,8 @@ struct SimServer::Impl {
     while (recent.size() > 8) recent.pop_front();
     auto type = static_cast<MissionType>(m.type());
     spdlog::info("tick {}: mission seq {} {} released", tick, m.seq(), to_string(type));
+    // A repeat only gathers acknowledgements again; its effects happened the first time.
+    if (!released_missions.insert({m.issuer_instance(), m.seq()}).second) return;
     if (type == MissionType::kSetDistance) d_int = m.value();
     if (referee.running() && (type == MissionType::kLand || type == MissionType::kTask ||
                               type == MissionType::kMove || type == MissionType::kFollowLeader))
@@ -416,6 +427,12 @@ struct SimServer::Impl {
       std::lock_guard<std::mutex> lock(mu);
       release_mission();
       swarm_msg.recent_commands().assign(recent.begin(), recent.end());
+      // The radio medium: beacons sent last tick, in drone order, with the
+      // sender's true position for the receivers' range models.
+      std::sort(pending_beacons.begin(), pending_beacons.end(),
+                [](const msg::Beacon& a, const msg::Beacon& b) { return a.drone_id() < b.drone_id(); });
+      swarm_msg.beacons() = std::move(pending_beacons);
+      pending_beacons.clear();
       published_tick = tick;
       for (auto& s : slots) s.answered = false;
     }
@@ -465,6 +482,7 @@ struct SimServer::Impl {
       if (failsafe_since[i] < 0) positions.push_back(st.p_world);
       else if (referee.running()) {}  // a drone in failsafe no longer counts for the task
     }
+    for (auto& b : swarm_msg.beacons()) b.true_position(swarm_msg.drones()[b.drone_id()].position());
     bool task_changed = referee.update(t, positions, cfg.sim.task_timeout_s);
     w_swarm.write(swarm_msg);
     if (cfg.sim.publish_per_drone_topics) {

@@ -19,6 +19,8 @@
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "common/convert.hpp"
 #include "common/participant.hpp"
@@ -255,6 +257,11 @@ int main(int argc, char** argv) {
                 w.failsafe_samples, w.not_live_samples, w.non_finite_samples);
 
     std::vector<std::string> failures;
+    // The legitimate agent alone must never trip the gate.
+    if (before.rejected_non_finite() + before.rejected_absurd() + before.rejected_unknown_id() +
+            before.rejected_stale_tick() + before.rejected_future_tick() + before.rejected_impostor() +
+            before.rejected_mission() > 0)
+      failures.push_back("the legitimate agent's own samples were rejected before the attack");
     auto grew = [&](const char* name, std::uint64_t b, std::uint64_t a) {
       if (a <= b) failures.push_back(fmt::format("rejected_{} did not grow ({} -> {})", name, b, a));
     };
