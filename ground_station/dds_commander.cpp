@@ -116,6 +116,22 @@ struct DdsCommander::Impl {
     return d > 0 ? d : 4.0;
   }
 
+  /// Waits until done() holds (evaluated with mu held) or timeout_s; false
+  /// on timeout or when a stop was requested.
+  template <class Pred>
+  bool wait(double timeout_s, Pred done) {
+    std::unique_lock<std::mutex> lock(mu);
+    return cv.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                       [&] { return stop_requested() || done(); }) &&
+           !stop_requested();
+  }
+
+  /// The server hears our commands and every online agent's acks reach us. mu held.
+  bool all_matched() const {
+    return w_mission.matched() > 0 &&
+           ack_reader->matched() >= static_cast<int>(online_locked().size());
+  }
+
   CommandResult send(MissionCommand c) {
     std::unique_lock<std::mutex> lock(mu);
     c.seq = ++seq;
@@ -185,55 +201,42 @@ DdsCommander::DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds)
 DdsCommander::~DdsCommander() = default;
 
 bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
-  std::unique_lock<std::mutex> lock(impl_->mu);
-  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-    if (stop_requested()) return true;
+  return impl_->wait(timeout_s, [&] {
     if (!impl_->sim) return false;
     int want = count >= 0 ? count : impl_->sim->num_drones();
-    const int online = static_cast<int>(impl_->online_locked().size());
-    return online >= want && impl_->w_mission.matched() > 0 && impl_->ack_reader->matched() >= online;
-  }) && !stop_requested();
+    return impl_->online_locked().size() >= static_cast<std::size_t>(want) && impl_->all_matched();
+  });
 }
 
 bool DdsCommander::wait_for_server(double timeout_s) {
-  std::unique_lock<std::mutex> lock(impl_->mu);
-  const bool all_matched = impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-    if (stop_requested()) return true;
-    // Acks written before an agent's writer matched our reader would be lost
-    // (volatile QoS), so every live agent must be matched before we speak.
-    const int online = static_cast<int>(impl_->online_locked().size());
-    return impl_->sim && impl_->w_mission.matched() > 0 && online >= impl_->sim->agents_live() &&
-           impl_->ack_reader->matched() >= online;
+  // Acks written before an agent's writer matched our reader would be lost
+  // (volatile QoS), so every live agent should be matched before we speak.
+  const bool all = impl_->wait(timeout_s, [&] {
+    return impl_->sim && impl_->online_locked().size() >= impl_->sim->agents_live() &&
+           impl_->all_matched();
   });
   if (stop_requested()) return false;
   // A frozen or unreachable agent never matches: go on once the server is
   // there, and let the acknowledgements name whoever stays silent.
-  return all_matched || (impl_->sim && impl_->w_mission.matched() > 0);
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  return all || (impl_->sim && impl_->w_mission.matched() > 0);
 }
 
 bool DdsCommander::wait_sim_time(double t, double timeout_s) {
-  std::unique_lock<std::mutex> lock(impl_->mu);
-  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-    return stop_requested() || (impl_->sim && impl_->sim->sim_time_s() >= t);
-  }) && !stop_requested();
+  return impl_->wait(timeout_s, [&] { return impl_->sim && impl_->sim->sim_time_s() >= t; });
 }
 
 bool DdsCommander::wait_airborne(int count, double timeout_s) {
-  std::unique_lock<std::mutex> lock(impl_->mu);
-  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-    return stop_requested() || (impl_->sim && impl_->sim->airborne() == count);
-  }) && !stop_requested();
+  return impl_->wait(timeout_s, [&] { return impl_->sim && impl_->sim->airborne() == count; });
 }
 
 bool DdsCommander::wait_takeoff_done(int count, double timeout_s) {
-  std::unique_lock<std::mutex> lock(impl_->mu);
-  return impl_->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-    if (stop_requested()) return true;
+  return impl_->wait(timeout_s, [&] {
     if (!impl_->sim || impl_->sim->airborne() < count) return false;
     for (int id : impl_->online_locked())
       if (impl_->agents.count(id) && impl_->agents.at(id).phase == Phase::kTakeoff) return false;
     return true;
-  }) && !stop_requested();
+  });
 }
 
 CommandResult DdsCommander::takeoff(double altitude_m) {

@@ -622,7 +622,48 @@ std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
     fs::remove(base + ".log", rm);
     pngs.push_back(base + ".png");
   }
+  if (summaries.size() > 1) pngs.push_back(write_summary_plot(summaries, dir));
   return pngs;
+}
+
+std::string write_summary_plot(const std::vector<SetSummary>& sets, const std::string& dir) {
+  // One bar per set: mean task time with its standard deviation, so a sweep
+  // reads at a glance; the failure count sits on top of a set that had any.
+  std::ostringstream dat;
+  dat << "# index mean_s stddev_s failures name\n";
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const auto& s = sets[i];
+    dat << i << ' ' << (std::isfinite(s.mean_time_s) ? number_text(s.mean_time_s) : "NaN") << ' '
+        << (std::isfinite(s.stddev_time_s) ? number_text(s.stddev_time_s) : "0") << ' '
+        << s.failures << " \"";
+    for (char c : s.name) dat << (c == '"' ? '\'' : c);  // data columns quote with "
+    dat << "\"\n";
+  }
+  const std::string base = dir + "/summary";
+  write_text(base + ".dat", dat.str());
+  std::ostringstream gp;
+  gp << "data = " << gnuplot_string(base + ".dat") << "\n"
+     << "set title 'Task time per set (mean and standard deviation)'\n"
+     << "set ylabel 'Time to complete [s]'\nset yrange [0:*]\nset grid ytics\n"
+     << "set style fill solid 0.6 border -1\nset boxwidth 0.6\nset xtics rotate by -30\n"
+     << "set xrange [-0.6:" << sets.size() - 0.4 << "]\nunset key\n"
+     << "plot data using 1:2:xtic(5) with boxes lc rgb '#1f77b4', \\\n"
+     << "     data using 1:2:3 with yerrorbars pt 0 lc rgb 'black', \\\n"
+     << "     data using 1:($4 > 0 ? $2 : 1/0):(sprintf('%d failed', $4)) with labels offset 0,1.2\n";
+  std::ostringstream script;
+  script << "if (strstrt(GPVAL_TERMINALS, ' pngcairo ') > 0) {\n"
+         << "  set terminal pngcairo size 900,500 noenhanced font 'sans,10'\n"
+         << "} else {\n  set terminal png size 900,500 noenhanced\n}\n"
+         << "set output " << gnuplot_string(base + ".png") << "\n"
+         << gp.str() << "set terminal svg size 900,500 noenhanced\n"
+         << "set output " << gnuplot_string(base + ".svg") << "\nreplot\nunset output\n";
+  write_text(base + ".gp", script.str());
+  run_gnuplot(dir, base + ".gp", base + ".log");
+  std::error_code rm;
+  if (fs::file_size(base + ".png", rm) == 0 || rm)
+    throw std::runtime_error(base + ".png: gnuplot wrote no plot (see " + base + ".log)");
+  fs::remove(base + ".log", rm);
+  return base + ".png";
 }
 
 }  // namespace ddswarm::gs

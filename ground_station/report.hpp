@@ -91,6 +91,11 @@ std::string plot_stem(const std::string& set_name);
 /// <stem>.svg. Creates out_dir. Stems that collide get a numeric suffix.
 /// Returns the png paths. Throws std::runtime_error when gnuplot is missing or
 /// fails (with its message), or a file cannot be written.
+/// Writes <dir>/summary.png and .svg: one bar per set, mean task time with its
+/// standard deviation (the sweep at a glance). Returns the png path; throws
+/// std::runtime_error when gnuplot fails. write_plots() calls it for 2+ sets.
+std::string write_summary_plot(const std::vector<SetSummary>& sets, const std::string& dir);
+
 std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
                                      const std::string& out_dir);
 

@@ -270,11 +270,16 @@ TEST_F(ReportTest, PlotsEveryRunOfEachSetAsPngAndSvg) {
   auto records = two_sets();
   records.push_back(run("sim_1", 0, kNaN, false));  // same stem as "Sim 1", no successful run
   const auto pngs = write_plots(records, path("plots"));
-  ASSERT_EQ(pngs.size(), 3u);
+  ASSERT_EQ(pngs.size(), 4u) << "one plot per set, then the summary of all sets";
   EXPECT_EQ(pngs[0], path("plots/sim_1.png"));
   EXPECT_EQ(pngs[1], path("plots/sim_2.png"));
   EXPECT_EQ(pngs[2], path("plots/sim_1_2.png"));
-  for (const std::string stem : {"sim_1", "sim_2", "sim_1_2"}) {
+  EXPECT_EQ(pngs[3], path("plots/summary.png"));
+  // The summary has one bar per set, labelled with the set's name.
+  const std::string summary = slurp(path("plots/summary.dat"));
+  EXPECT_NE(summary.find("\"Sim 1\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"Sim 2\""), std::string::npos) << summary;
+  for (const std::string stem : {"sim_1", "sim_2", "sim_1_2", "summary"}) {
     SCOPED_TRACE(stem);
     const std::string base = path("plots/" + stem);
     EXPECT_EQ(slurp(base + ".png").substr(0, 8), "\x89PNG\r\n\x1a\n");

@@ -16,6 +16,7 @@ grep -q "| Slow | Fast |" "$out/short.md" || grep -q "Slow.*Fast" "$out/short.md
 grep -q "Avg. task time" "$out/short.md" || fail "table lacks Table 1's task-time row"
 pngs=$(ls "$out"/plots/*.png 2>/dev/null | wc -l)
 svgs=$(ls "$out"/plots/*.svg 2>/dev/null | wc -l)
-[ "$pngs" -ge 2 ] && [ "$svgs" -ge 2 ] || fail "expected a PNG and an SVG per set, found $pngs PNG, $svgs SVG"
+[ "$pngs" -ge 3 ] && [ "$svgs" -ge 3 ] || fail "expected a PNG and an SVG per set plus the summary, found $pngs PNG, $svgs SVG"
+[ -s "$out/plots/summary.png" ] || fail "no summary plot"
 ls "$out"/runs/*.yaml | wc -l | grep -qx 4 || fail "expected 4 per-run scenarios"
 echo PASS
