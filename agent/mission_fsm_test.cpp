@@ -258,6 +258,9 @@ TEST(MissionFsm, LeaderFollowsTeleopWhichExpires) {
   EXPECT_EQ(leader.out.phase, Phase::kFollow);
   EXPECT_EQ(leader.out.mission_velocity, Vector3d(0.5, 0.2, 0));
   EXPECT_EQ(follower.out.mission_velocity, Vector3d::Zero()) << "followers swarm around";
+  EXPECT_FALSE(leader.out.swarm_enabled) << "the pilot's drone is not pulled back by its followers";
+  EXPECT_TRUE(leader.out.obstacle_avoidance_enabled) << "but still avoids obstacles";
+  EXPECT_TRUE(follower.out.swarm_enabled);
   leader.run_until([&] { return false; }, 1.2);  // the link goes quiet
   EXPECT_EQ(leader.out.mission_velocity, Vector3d::Zero());
   EXPECT_EQ(leader.out.phase, Phase::kFollow);

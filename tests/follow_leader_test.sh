@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Issues 3 and 4: follow the leader (the thesis's RC drone). Drone 0 is flown
+# by velocity commands from the ground station; the others swarm around it.
+source "$(dirname "$0")/lib.sh"
+scenario="$SRC/tests/scenarios/scattered.yaml"
+gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
+# Each teleop is its own process here (~0.5 s apart): give the link 3 s before it lapses.
+start launch "$BIN/ddswarm-launch" "$scenario" --mode realtime --domain "$DOMAIN" --drones 4 \
+  --set agent.teleop_timeout_s=3 --log-dir "$WORK/logs"
+gs wait-agents --count 4 --timeout 60 || fail "agents not online"
+gs takeoff --wait || fail "takeoff"
+gs hold --time 5 --wait || fail "hold"
+centroid() {  # prints "leader_y centroid_y"
+  gs status --drones | awk '$1 ~ /^[0-9]+$/ { if ($1 == 0) l = $3; s += $3; n++ } END { printf "%.2f %.2f\n", l, s / n }'
+}
+read l0 c0 < <(centroid)
+gs follow --leader 0 || fail "follow"
+# Fly the leader north at 1 m/s for ~8 s: teleop lapses after 1 s without news, so keep it fresh.
+end=$((SECONDS + 8))
+while [ $SECONDS -lt $end ]; do gs teleop --north 1.0 >/dev/null || fail "teleop"; sleep 0.3; done
+read l1 c1 < <(centroid)
+echo "leader y $l0 -> $l1, swarm centroid y $c0 -> $c1"
+awk -v a="$l0" -v b="$l1" 'BEGIN{exit !(b - a > 4.0)}' || fail "the leader did not fly north"
+awk -v a="$c0" -v b="$c1" 'BEGIN{exit !(b - a > 3.0)}' || fail "the swarm did not follow its leader"
+gs hold >/dev/null || fail "hold after follow"
+gs status --drones
+echo PASS
