@@ -83,6 +83,7 @@ struct AgentApp::Impl {
 
   std::mutex mu;  // guards everything below (DDS callbacks run on Fast DDS threads)
   std::optional<SceneConfig> scene;
+  eprosima::fastrtps::rtps::GuidPrefix_t server;  // the scene's publisher
   std::unique_ptr<MissionFsm> fsm;
   TruthPeerSource truth;
   std::unique_ptr<ModelledPeerSource> modelled;  // when comm asks for more than exact truth
@@ -126,8 +127,11 @@ struct AgentApp::Impl {
       rival = s.agent_instance();
       rival_where = s.host().to_string() + " pid " + std::to_string(s.pid());
     });
-    dds.reader<msg::Scene>([this](const msg::Scene& s, const fdds::SampleInfo&) {
+    dds.reader<msg::Scene>([this](const msg::Scene& s, const fdds::SampleInfo& info) {
       std::lock_guard<std::mutex> lock(mu);
+      // The participant that announces the scene is the server: swarm samples
+      // are taken from it alone. A restarted server announces itself again.
+      server = info.sample_identity.writer_guid().guidPrefix;
       if (s.num_drones() <= id) {
         spdlog::error("drone {}: the server flies only {} drones", id, s.num_drones());
         return;
@@ -166,8 +170,9 @@ struct AgentApp::Impl {
       flying = true;
     }
     publish_status();
-    dds.reader<msg::SwarmState>(
-        [this](const msg::SwarmState& s, const fdds::SampleInfo&) { on_swarm(s); });
+    dds.reader<msg::SwarmState>([this](const msg::SwarmState& s, const fdds::SampleInfo& info) {
+      on_swarm(s, info.sample_identity.writer_guid().guidPrefix);
+    });
   }
 
   void publish_status() {
@@ -191,9 +196,13 @@ struct AgentApp::Impl {
   }
 
   /// One server tick: check the sample, apply new mission commands, run the law, answer.
-  void on_swarm(const msg::SwarmState& s) {
+  void on_swarm(const msg::SwarmState& s, const eprosima::fastrtps::rtps::GuidPrefix_t& from) {
     std::lock_guard<std::mutex> lock(mu);
     if (!fsm) return;  // no scene yet
+    if (from != server) {  // not the server that announced the scene
+      ++rejected;
+      return;
+    }
     if (s.drones().size() <= static_cast<std::size_t>(id) || s.drones()[id].drone_id() != id) {
       ++rejected;
       return;

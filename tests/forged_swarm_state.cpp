@@ -1,0 +1,80 @@
+// Issue 3: an agent ignores swarm samples that do not come from its server
+// (forged by another participant: NaN positions, a tick far in the future),
+// counts them, and keeps flying on the real ones. Exit 0 when it did.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <mutex>
+
+#include "common/convert.hpp"
+#include "common/participant.hpp"
+#include "common/process.hpp"
+
+using namespace ddswarm;
+
+int main(int argc, char** argv) {
+  return run_main("forged_swarm_state", [&]() -> int {
+    CLI::App app{"forge SwarmState samples at a running agent"};
+    DdsConfig dds;
+    double attack_s = 3.0, z = 2.0, tolerance = 0.15;
+    app.add_option("--domain", dds.domain_id);
+    app.add_option("--attack", attack_s, "wall seconds of forged samples");
+    app.add_option("--z", z, "m, the altitude drone 0 holds");
+    CLI11_PARSE(app, argc, argv);
+    install_stop_signals();
+    Participant p(dds, "forger");
+    auto w = p.writer<msg::SwarmState>();
+    std::mutex mu;
+    std::uint64_t rejected_before = 0, rejected_now = 0, real_tick = 0;
+    bool have_status = false;
+    double max_dz = 0;
+    bool watching = false;
+    p.reader<msg::AgentStatus>([&](const msg::AgentStatus& a, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(mu);
+      if (a.drone_id() != 0) return;
+      rejected_now = a.rejected_samples();
+      if (!have_status) rejected_before = rejected_now;
+      have_status = true;
+    });
+    p.reader<msg::SwarmState>([&](const msg::SwarmState& s, const fdds::SampleInfo& info) {
+      if (info.sample_identity.writer_guid().guidPrefix == w.raw()->guid().guidPrefix) return;
+      std::lock_guard<std::mutex> lock(mu);
+      real_tick = s.tick();
+      if (watching && !s.drones().empty())
+        max_dz = std::max(max_dz, std::abs(s.drones()[0].position().z() - z));
+    });
+    for (int i = 0; i < 50 && !have_status; ++i) wait_for_stop(std::chrono::milliseconds(100));
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      if (!have_status) throw std::runtime_error("no heartbeat from agent 0");
+      rejected_before = rejected_now;
+      watching = true;
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double end = wall_seconds() + attack_s;
+    int sent = 0;
+    while (wall_seconds() < end && !stop_requested()) {
+      msg::SwarmState f;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        f.tick(sent % 2 ? real_tick + 1000000 : real_tick + 1);
+      }
+      f.sim_time_s(1e6);
+      f.drones().resize(1);
+      f.drones()[0].drone_id(0);
+      // Odd samples: NaN position; even: a plausible state 50 m away.
+      f.drones()[0].position(to_msg(sent % 2 ? Eigen::Vector3d(nan, nan, nan) : Eigen::Vector3d(50, 0, 2)));
+      w.write(f);
+      ++sent;
+      wait_for_stop(std::chrono::milliseconds(20));
+    }
+    wait_for_stop(std::chrono::milliseconds(800));  // one more heartbeat
+    std::lock_guard<std::mutex> lock(mu);
+    std::printf("forged %d samples; agent 0 rejected %llu; drone 0 height error at most %.3f m\n", sent,
+                static_cast<unsigned long long>(rejected_now - rejected_before), max_dz);
+    if (rejected_now - rejected_before < static_cast<std::uint64_t>(sent) / 2) return 1;
+    return max_dz <= tolerance ? 0 : 1;
+  });
+}
