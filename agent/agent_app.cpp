@@ -112,6 +112,9 @@ struct AgentApp::Impl {
     return v ? v : 1;
   }
 
+  // DDS callbacks touch the members below: stop them before anything is destroyed.
+  ~Impl() { dds.close(); }
+
   explicit Impl(AgentAppConfig c)
       : cfg(std::move(c)),
         id(cfg.drone_id),
@@ -330,6 +333,7 @@ struct AgentApp::Impl {
     in.swarm_enabled = out.swarm_enabled;
     in.obstacle_avoidance_enabled = out.obstacle_avoidance_enabled;
     in.altitude_hold = out.altitude_hold;
+    in.swarm_horizontal_only = out.swarm_horizontal_only;
     in.altitude_target_m = out.altitude_target_m;
     Eigen::Vector3d v = out.motors_on ? control_velocity(in, cfg.agent) : Eigen::Vector3d::Zero();
 

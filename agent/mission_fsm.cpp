@@ -231,6 +231,7 @@ MissionOutput MissionFsm::step(const Observation& o) {
       break;
     case Phase::kLanding:
       out.mission_velocity = Eigen::Vector3d(0, 0, -cfg_.landing_speed_mps);
+      out.swarm_horizontal_only = true;
       out.altitude_hold = false;
       out.altitude_target_m = scene_.ground_z_m;
       out.busy = true;
@@ -253,6 +254,7 @@ void set_mission(LawInput& in, const MissionOutput& out) {
   in.obstacle_avoidance_enabled = out.obstacle_avoidance_enabled;
   in.altitude_hold = out.altitude_hold;
   in.altitude_target_m = out.altitude_target_m;
+  in.swarm_horizontal_only = out.swarm_horizontal_only;
 }
 
 }  // namespace ddswarm::agent

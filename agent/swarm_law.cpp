@@ -119,6 +119,7 @@ LawTerms evaluate_law(const LawInput& in, const AgentConfig& c) {
   LawTerms t;
   if (in.swarm_enabled)
     t.swarm = repulsion_attraction(in.p_world, in.peers_world, in.inter_distance_m, c.activation);
+  if (in.swarm_horizontal_only) t.swarm.z() = 0;
   Eigen::Vector3d other = t.swarm + in.mission_velocity;
 
   if (in.obstacle_avoidance_enabled) {

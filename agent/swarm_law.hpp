@@ -91,6 +91,8 @@ struct LawInput {
   bool swarm_enabled = true;                  ///< include C
   bool obstacle_avoidance_enabled = true;     ///< include C_s and the safety distance
   bool altitude_hold = true;                  ///< replace vertical terms by the altitude loop
+  bool swarm_horizontal_only = false;         ///< drop C's vertical part (landing: peers already
+                                              ///< on the ground must not hold a drone up)
   double altitude_target_m = 2.0;             ///< m, world z held when altitude_hold
 };
 

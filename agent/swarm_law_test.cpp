@@ -415,3 +415,18 @@ TEST(ControlVelocity, SlidesRoundAPillarDeadAheadInsteadOfStalling) {
   in.mission_velocity = Vector3d(-0.3, 0.8, 0);
   EXPECT_LT(evaluate_law(in, cfg).slide.x(), 0.0);
 }
+
+TEST(ControlVelocity, LandingIsNotHeldUpByDronesAlreadyOnTheGround) {
+  AgentConfig cfg;
+  // Three peers landed 2.5 m below: closer than D_int, so Eq. 3.2 repels upward.
+  const std::vector<Vector3d> peers = {{0.5, 0, 0.05}, {-0.5, 0.4, 0.05}, {0, -0.6, 0.05}};
+  LawInput in;
+  in.p_world = Vector3d(0, 0, 2.5);
+  in.peers_world = peers;
+  in.obstacle_avoidance_enabled = false;
+  in.altitude_hold = false;
+  in.mission_velocity = Vector3d(0, 0, -cfg.landing_speed_mps);
+  EXPECT_GT(evaluate_law(in, cfg).velocity.z(), -0.1) << "the thesis law alone stalls the descent";
+  in.swarm_horizontal_only = true;
+  EXPECT_NEAR(evaluate_law(in, cfg).velocity.z(), -cfg.landing_speed_mps, 1e-9);
+}

@@ -117,9 +117,14 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   if (!publisher_ || !subscriber_) throw DdsError("cannot create DDS publisher/subscriber");
 }
 
+void Participant::close() {
+  if (participant_ && !closed_) participant_->delete_contained_entities();
+  closed_ = true;
+}
+
 Participant::~Participant() {
   if (!participant_) return;
-  participant_->delete_contained_entities();
+  close();
   fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
 }
 

@@ -85,6 +85,11 @@ class Participant {
   /// Joins the domain; throws DdsError naming what failed. name shows in tools.
   Participant(const DdsConfig& cfg, const std::string& name);
   ~Participant();
+  /// Deletes every reader and writer, waiting for running callbacks, so no
+  /// handler runs afterwards. Owners whose handlers touch their own members
+  /// must call this first in their destructor (members die before the
+  /// Participant otherwise). Idempotent.
+  void close();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
 
@@ -128,6 +133,7 @@ class Participant {
   }
 
   fdds::DomainParticipant* participant_ = nullptr;
+  bool closed_ = false;
   fdds::Publisher* publisher_ = nullptr;
   fdds::Subscriber* subscriber_ = nullptr;
   std::mutex mu_;

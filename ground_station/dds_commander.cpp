@@ -55,6 +55,9 @@ struct DdsCommander::Impl {
   Reader<msg::MissionAck>* ack_reader = nullptr;
   std::optional<TaskOutcome> outcome;
 
+  // DDS callbacks touch the members below: stop them before anything is destroyed.
+  ~Impl() { dds.close(); }
+
   Impl(const GroundStationConfig& c, const DdsConfig& d)
       : cfg(c),
         instance([] {

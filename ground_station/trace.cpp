@@ -39,6 +39,7 @@ struct SwarmTrace::Impl {
     });
   }
   ~Impl() {
+    dds.close();  // no callback may write to the file once it is closed
     std::lock_guard<std::mutex> lock(mu);
     std::fclose(f);
   }

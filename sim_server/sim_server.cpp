@@ -121,6 +121,9 @@ struct SimServer::Impl {
   TaskPhase last_task_phase = TaskPhase::kNone;
   double last_task_publish_wall = -1e9;
 
+  // DDS callbacks touch the members below: stop them before anything is destroyed.
+  ~Impl() { dds.close(); }
+
   explicit Impl(ServerConfig c)
       : cfg(std::move(c)),
         n(cfg.scenario.drones),
