@@ -41,4 +41,22 @@ DDSWARM_TOPIC(Beacon, "ddswarm/beacon", "state_keyed");
 
 #undef DDSWARM_TOPIC
 
+/// Calls f.template operator()<T>() for every message type that has a topic
+/// (for tools that handle all of them: recorder, replay).
+template <class F>
+void for_each_topic_type(F&& f) {
+  f.template operator()<msg::SwarmState>();
+  f.template operator()<msg::DroneState>();
+  f.template operator()<msg::DistanceScan>();
+  f.template operator()<msg::Scene>();
+  f.template operator()<msg::SimStatus>();
+  f.template operator()<msg::CollisionEvent>();
+  f.template operator()<msg::TaskStatus>();
+  f.template operator()<msg::VelocityCommand>();
+  f.template operator()<msg::AgentStatus>();
+  f.template operator()<msg::MissionCommand>();
+  f.template operator()<msg::MissionAck>();
+  f.template operator()<msg::Beacon>();
+}
+
 }  // namespace ddswarm

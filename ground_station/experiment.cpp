@@ -128,6 +128,11 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
           a.push_back(std::to_string(opt.dds.domain_id));
           return a;
         };
+        if (!opt.record_dir.empty()) {
+          fs::create_directories(opt.record_dir);
+          procs.start({"record", common_args({bin + "/ddswarm-record", "-o",
+                                              opt.record_dir + "/" + tag + ".mcap"})});
+        }
         procs.start({"sim", common_args({bin + "/ddswarm-sim", "--scenario", scenario_file})});
         for (int i = 0; i < rec.drones; ++i)
           procs.start({"agent " + std::to_string(i),

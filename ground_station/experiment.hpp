@@ -22,6 +22,7 @@ struct ExperimentOptions {
   DdsConfig dds;                    ///< domain and network of every run
   GroundStationConfig gs;
   std::string bin_dir;              ///< where ddswarm-sim / ddswarm-agent live (default: next to us)
+  std::string record_dir;           ///< when set, each run's DDS traffic goes to <record_dir>/<run>.mcap
 };
 
 /// Runs every set's runs in order; returns 0 when every run completed, 1 when

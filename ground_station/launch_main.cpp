@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -93,6 +94,8 @@ int main(int argc, char** argv) {
     app.add_flag("--gs-interactive", gs_interactive, "open the ground-station console here");
     app.add_option("--log-dir", log_dir, "write each process's log to DIR/<name>.log instead of the terminal");
     app.add_option("--duration", duration_s, "stop everything after this many wall seconds");
+    std::string record_dir;
+    app.add_option("--record", record_dir, "record the run's DDS traffic to DIR/run-<time>.mcap");
     std::vector<std::string> sets;
     app.add_option("--set", sets,
                    "override a scenario key for this run, e.g. --set comm.latency_s=0.3 (repeatable)");
@@ -149,6 +152,16 @@ int main(int argc, char** argv) {
     install_stop_signals();
     const bool stop_on_death = on_death == "stop";
     Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
+    if (!record_dir.empty()) {
+      // First, so it hears everything; SIGTERM at the end makes it finalize the file.
+      std::filesystem::create_directories(record_dir);
+      const std::string out = record_dir + "/run-" + std::to_string(std::time(nullptr)) + ".mcap";
+      std::vector<std::string> a = {bin + "/ddswarm-record", "-o", out};
+      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      procs.start({"record", a});
+      std::cerr << "ddswarm-launch: recording to " << out << "\n";
+      wait_for_stop(std::chrono::milliseconds(500));
+    }
     if (only != "agents") {
       std::vector<std::string> a = {bin + "/ddswarm-sim", "--scenario", scenario, "--drones", std::to_string(n)};
       if (mode) {

@@ -120,6 +120,8 @@ int main(int argc, char** argv) {
     std::string exp_file, out_dir = "results";
     experiment->add_option("file", exp_file, "experiment YAML")->required();
     experiment->add_option("--out", out_dir, "output directory");
+    std::string record_dir;
+    experiment->add_option("--record", record_dir, "record each run's DDS traffic to DIR/<run>.mcap");
 
     try {
       app.parse(argc, argv);
@@ -138,6 +140,7 @@ int main(int argc, char** argv) {
       opt.out_dir = out_dir;
       opt.dds = file.dds;
       opt.gs = file.gs;
+      opt.record_dir = record_dir;
       return run_experiment(exp, opt, std::cout);
     }
 

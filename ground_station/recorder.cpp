@@ -1,0 +1,220 @@
+#include "ground_station/recorder.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <functional>
+#include <span>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "common/mcap/mcap_reader.hpp"
+#include "common/mcap/mcap_writer.hpp"
+#include "common/participant.hpp"
+#include "common/process.hpp"
+#include "ddswarm_idl_text.hpp"
+
+namespace ddswarm::gs {
+
+namespace {
+
+std::uint64_t now_ns() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
+/// The CDR bytes of a sample, encapsulation header included (as on the wire).
+template <class T>
+std::vector<std::uint8_t> to_cdr(const T& sample) {
+  typename Topic<T>::PubSub type;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(
+      type.getSerializedSizeProvider(const_cast<T*>(&sample))());
+  if (!type.serialize(const_cast<T*>(&sample), &payload))
+    throw std::runtime_error(std::string("cannot serialize a sample of ") + Topic<T>::name);
+  return std::vector<std::uint8_t>(payload.data, payload.data + payload.length);
+}
+
+std::set<std::string> all_topics() {
+  std::set<std::string> out;
+  for_each_topic_type([&]<class T>() { out.insert(Topic<T>::name); });
+  return out;
+}
+
+struct Item {
+  std::uint16_t channel;
+  std::uint64_t log_ns, publish_ns;
+  std::vector<std::uint8_t> data;
+};
+
+}  // namespace
+
+struct Recorder::Impl {
+  RecorderOptions opt;
+  mcap::Writer writer;
+  Participant dds;
+  std::mutex mu;
+  std::condition_variable cv;
+  std::deque<Item> queue;
+  std::size_t max_queue = 0;
+  std::map<std::uint16_t, std::string> channel_topic;
+  std::map<std::string, std::uint64_t> written;
+
+  static mcap::WriterOptions writer_options(const RecorderOptions& o) {
+    mcap::WriterOptions w;
+    w.compression = o.compression == "lz4"    ? mcap::Compression::lz4
+                    : o.compression == "none" ? mcap::Compression::none
+                                              : mcap::Compression::zstd;
+    w.chunk_size_bytes = o.chunk_bytes;
+    w.profile = "";
+    return w;
+  }
+
+  ~Impl() { dds.close(); }
+
+  Impl(const DdsConfig& d, RecorderOptions o)
+      : opt(std::move(o)), writer(opt.path, writer_options(opt)), dds(d, "ddswarm-record") {
+    const auto known = all_topics();
+    for (const auto& t : opt.topics)
+      if (!known.count(t))
+        throw std::invalid_argument("unknown topic " + t + " (known: " +
+                                    fmt::format("{}", fmt::join(known, ", ")) + ")");
+    for_each_topic_type([&]<class T>() {
+      const std::string topic = Topic<T>::name;
+      if (!opt.topics.empty() && std::find(opt.topics.begin(), opt.topics.end(), topic) == opt.topics.end())
+        return;
+      typename Topic<T>::PubSub type;
+      const std::uint16_t schema = writer.add_schema(type.getName(), "omgidl", kIdlText);
+      const std::uint16_t channel =
+          writer.add_channel(schema, topic, "cdr", {{"qos_profile", Topic<T>::profile}});
+      channel_topic[channel] = topic;
+      written[topic] = 0;
+      dds.reader<T>([this, channel](const T& sample, const fdds::SampleInfo& info) {
+        Item it{channel, now_ns(), static_cast<std::uint64_t>(info.source_timestamp.to_ns()), to_cdr(sample)};
+        std::lock_guard<std::mutex> lock(mu);
+        queue.push_back(std::move(it));
+        max_queue = std::max(max_queue, queue.size());
+        cv.notify_one();
+      });
+    });
+  }
+
+  /// Writes everything queued; false when the queue was empty.
+  bool drain() {
+    std::deque<Item> batch;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      batch.swap(queue);
+    }
+    for (const auto& it : batch) {
+      writer.write(it.channel, it.log_ns, it.publish_ns, it.data.data(), it.data.size());
+      ++written[channel_topic[it.channel]];
+    }
+    return !batch.empty();
+  }
+
+  RecorderCounts run(double duration_s) {
+    const double end = duration_s > 0 ? wall_seconds() + duration_s : 1e300;
+    while (!stop_requested() && wall_seconds() < end) {
+      {
+        std::unique_lock<std::mutex> lock(mu);
+        cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty(); });
+      }
+      drain();
+    }
+    // Stop listening, then write what arrived before the stop: nothing received is lost.
+    dds.close();
+    drain();
+    writer.close();
+    RecorderCounts c;
+    c.messages = written;
+    c.bytes = writer.bytes_written();
+    c.max_queue = max_queue;
+    return c;
+  }
+};
+
+Recorder::Recorder(const DdsConfig& dds, RecorderOptions options)
+    : impl_(std::make_unique<Impl>(dds, std::move(options))) {}
+Recorder::~Recorder() = default;
+RecorderCounts Recorder::run(double duration_s) { return impl_->run(duration_s); }
+
+std::string describe_recording(const std::string& path, bool messages) {
+  mcap::Reader r(path);
+  const auto& st = r.statistics();
+  std::string out = fmt::format("{}: {} messages on {} channels ({})\n", path, st.message_count,
+                                r.channels().size(), r.how_read().describe());
+  for (const auto& [id, ch] : r.channels()) {
+    auto it = st.channel_message_counts.find(id);
+    const auto& schema = r.schemas().count(ch.schema_id) ? r.schemas().at(ch.schema_id).name : "";
+    out += fmt::format("  {:<24} {:>9} messages  {}\n", ch.topic,
+                       it == st.channel_message_counts.end() ? 0 : it->second, schema);
+  }
+  const double start = st.message_start_time_ns * 1e-9, end = st.message_end_time_ns * 1e-9;
+  out += fmt::format("start {:.3f} s, end {:.3f} s (unix time), duration {:.3f} s\n", start, end,
+                     st.message_count ? end - start : 0.0);
+  if (messages) {
+    r.for_each_message([&](const mcap::MessageView& m) {
+      std::uint64_t h = 1469598103934665603ULL;
+      for (auto b : m.data) h = (h ^ b) * 1099511628211ULL;
+      const auto* ch = r.channel(m.channel_id);
+      out += fmt::format("{} {} {} {:016x}\n", m.log_time_ns, ch ? ch->topic : "?", m.data.size(), h);
+    });
+  }
+  return out;
+}
+
+std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double rate, bool loop,
+                     const std::vector<std::string>& topics) {
+  if (!(rate > 0)) throw std::invalid_argument("--rate must be > 0");
+  mcap::Reader r(path);
+  Participant dds(dds_cfg, "ddswarm-replay");
+  // One publisher per recorded channel whose topic ddswarm knows.
+  std::map<std::uint16_t, std::function<void(std::span<const std::uint8_t>)>> publish;
+  for (const auto& [id, ch] : r.channels()) {
+    if (!topics.empty() && std::find(topics.begin(), topics.end(), ch.topic) == topics.end()) continue;
+    for_each_topic_type([&, id = id]<class T>() {
+      if (ch.topic != Topic<T>::name) return;
+      auto w = std::make_shared<Writer<T>>(dds.writer<T>());
+      publish[id] = [w](std::span<const std::uint8_t> bytes) {
+        typename Topic<T>::PubSub type;
+        eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
+        std::memcpy(payload.data, bytes.data(), bytes.size());
+        payload.length = static_cast<std::uint32_t>(bytes.size());
+        T sample;
+        if (type.deserialize(&payload, &sample)) w->write(sample);
+      };
+    });
+  }
+  // Let readers match before the first sample (volatile samples sent earlier are lost).
+  wait_for_stop(std::chrono::milliseconds(1500));
+  std::uint64_t sent = 0;
+  do {
+    const auto start = std::chrono::steady_clock::now();
+    std::uint64_t first = 0;
+    bool have_first = false;
+    r.for_each_message([&](const mcap::MessageView& m) {
+      if (stop_requested()) return;
+      auto it = publish.find(m.channel_id);
+      if (it == publish.end()) return;
+      if (!have_first) {
+        first = m.log_time_ns;
+        have_first = true;
+      }
+      const double offset_s = (m.log_time_ns - first) * 1e-9 / rate;
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                std::chrono::duration<double>(offset_s)));
+      it->second(m.data);
+      ++sent;
+    });
+  } while (loop && !stop_requested());
+  wait_for_stop(std::chrono::milliseconds(500));  // let reliable samples go out
+  return sent;
+}
+
+}  // namespace ddswarm::gs

@@ -1,0 +1,53 @@
+#pragma once
+// Records the swarm's DDS traffic to MCAP (ROS 2 / Foxglove's log format):
+// one channel per topic, the IDL as an omgidl schema, CDR payloads with
+// receive (log) and source (publish) times, compressed chunks and a summary.
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/dds_config.hpp"
+
+namespace ddswarm::gs {
+
+struct RecorderOptions {
+  std::string path;                  ///< output .mcap
+  std::vector<std::string> topics;   ///< topic names to record; empty = every ddswarm topic
+  std::string compression = "zstd";  ///< zstd | lz4 | none
+  std::uint64_t chunk_bytes = 1 << 20;  ///< uncompressed bytes per chunk (what a crash can lose at most)
+};
+
+struct RecorderCounts {
+  std::map<std::string, std::uint64_t> messages;  ///< per topic, written
+  std::uint64_t bytes = 0;                        ///< file size
+  std::size_t max_queue = 0;                      ///< most samples waiting for the disk at once
+};
+
+class Recorder {
+ public:
+  /// Opens the file (throws std::runtime_error naming it when it cannot be
+  /// written) and subscribes. Unknown topic names throw std::invalid_argument.
+  Recorder(const DdsConfig& dds, RecorderOptions options);
+  ~Recorder();
+  /// Records until stop_requested() or duration_s (<= 0: forever); then writes
+  /// every received sample, the summary and the footer. Throws on a write error
+  /// (disk full): the message names the file.
+  RecorderCounts run(double duration_s);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// `ddswarm-record info`: topics, message counts, start, end, duration; with
+/// messages, one line per message: log time (ns), topic, bytes, FNV-1a hash of the payload.
+std::string describe_recording(const std::string& path, bool messages = false);
+
+/// Republishes a recording with its original timing scaled by rate (> 0);
+/// loops when asked, until stop_requested(). Returns messages published.
+std::uint64_t replay(const DdsConfig& dds, const std::string& path, double rate, bool loop,
+                     const std::vector<std::string>& topics);
+
+}  // namespace ddswarm::gs
