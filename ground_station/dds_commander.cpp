@@ -225,6 +225,10 @@ bool DdsCommander::wait_for_server(double timeout_s) {
   return all || (impl_->sim && impl_->w_mission.matched() > 0);
 }
 
+bool DdsCommander::wait_for_status(double timeout_s) {
+  return impl_->wait(timeout_s, [&] { return impl_->sim.has_value(); });
+}
+
 bool DdsCommander::wait_sim_time(double t, double timeout_s) {
   return impl_->wait(timeout_s, [&] { return impl_->sim && impl_->sim->sim_time_s() >= t; });
 }

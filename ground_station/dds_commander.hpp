@@ -39,6 +39,8 @@ class DdsCommander final : public Commander {
   /// Waits until the server's status is heard, the mission writer is matched,
   /// and a heartbeat has arrived from every agent the server hears.
   bool wait_for_server(double timeout_s);
+  /// Waits until a SimStatus arrives (a live server or a replay). False on timeout.
+  bool wait_for_status(double timeout_s);
   /// Waits until sim time reaches t (s). False on timeout (wall) or stop.
   bool wait_sim_time(double t, double timeout_s);
   /// Waits until `airborne` drones are airborne (or on the ground when 0).

@@ -153,7 +153,10 @@ int main(int argc, char** argv) {
     DdsCommander gs(file.gs, file.dds);
     const bool interactive = app.get_subcommands().empty() || *menu;
     // Give discovery a moment: the server's status is transient-local.
-    if (!gs.wait_for_server(file.gs.discovery_timeout_s) && !interactive) {
+    // Status needs only the clock (a replayed recording has no server to command).
+    const bool ready = *status ? gs.wait_for_status(file.gs.discovery_timeout_s)
+                               : gs.wait_for_server(file.gs.discovery_timeout_s);
+    if (!ready && !interactive) {
       std::fprintf(stderr, "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",
                    file.dds.domain_id, file.gs.discovery_timeout_s);
       return 1;

@@ -48,6 +48,7 @@ grep -q "scanned" "$WORK/c.info" || fail "expected a scanned (summary-less) read
 n=$(awk 'NR == 1 { print $2 }' "$WORK/c.info")
 [ "${n:-0}" -gt 100 ] || fail "only ${n:-0} messages survived the kill"
 if [ $node_ok -eq 1 ]; then timeout 60 node --single-threaded "$reader" "$WORK/c.mcap" --stream-only >/dev/null || fail "independent reader cannot read the killed file"; fi
+kill -TERM "$PID_sim"; wait_pid "$PID_sim" 10 || fail "server did not stop"
 
 # 4. A full disk and an unwritable path are clear errors, never a silent truncation.
 out=$(timeout 20 "$BIN/ddswarm-record" -o /dev/full --domain "$DOMAIN" --duration 3 2>&1); rc=$?
@@ -55,4 +56,16 @@ out=$(timeout 20 "$BIN/ddswarm-record" -o /dev/full --domain "$DOMAIN" --duratio
 echo "$out" | grep -q "/dev/full" || fail "full-disk error does not name the file: $out"
 out=$(timeout 20 "$BIN/ddswarm-record" -o /nonexistent/dir/x.mcap --domain "$DOMAIN" --duration 1 2>&1); rc=$?
 [ $rc -ne 0 ] && echo "$out" | grep -q "/nonexistent/dir/x.mcap" || fail "unwritable path: rc $rc: $out"
+# 5. A live run recorded by the launcher, then replayed: the ground station's
+#    status works on the replay as on the live run.
+timeout 120 "$BIN/ddswarm-launch" "$SRC/config/thesis_course.yaml" --drones 3 --mode lockstep --domain "$DOMAIN" \
+  --record "$WORK/runs" --log-dir "$WORK/logs" --gs "takeoff --wait; land --wait" >"$WORK/launch.log" 2>&1 || fail "recorded run failed"
+run=$(ls "$WORK"/runs/*.mcap | head -1)
+"$BIN/ddswarm-record" info "$run" | tee "$WORK/run.info" | head -3
+grep -Eq "ddswarm/swarm_state +[1-9][0-9]* messages" "$WORK/run.info" || fail "the launcher's recording has no swarm state"
+start replay "$BIN/ddswarm-replay" "$run" --domain "$DOMAIN" --loop
+sleep 2.5
+out=$(timeout 30 "$BIN/ddswarm-gs" --domain "$DOMAIN" status 2>&1) || fail "status on a replay failed: $out"
+echo "status on the replay: $out"
+echo "$out" | grep -q "3/3 online\|drones [0-9]/3" || fail "status does not show the replayed swarm: $out"
 echo PASS
