@@ -180,7 +180,6 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
     out << "plots: " << opt.out_dir << "/plots\n";
   } catch (const std::exception& e) {
     out << "plots not written: " << e.what() << "\n";
-    failed += 0;
   }
   out << fmt::format("{} runs, {} failed, {} wall; CSV {}\n", done, failed, clock(wall_seconds() - t0), csv);
   return failed == 0 && done == total ? 0 : 1;

@@ -122,6 +122,9 @@ int main(int argc, char** argv) {
       std::cerr << "ddswarm-launch: scenario with overrides written to " << path << "\n";
       scenario = path;
     }
+    if (app.count("--participant-id"))
+      throw FieldError("--participant-id", app.get_option("--participant-id")->as<std::string>(),
+                       "names one process; the launcher starts many (see docs/networking.md, large swarms)");
     auto file = load_gs_config(scenario);
     const int n = drones.value_or(file.drones);
     if (n < 1 || n > 1024) throw FieldError("--drones", std::to_string(n), "must be in [1, 1024]");

@@ -119,6 +119,7 @@ struct SimServer::Impl {
   double last_status_wall = -1e9, rtf_wall = 0, rtf_sim = 0, rtf = 0;
   double start_wall = 0;
   TaskPhase last_task_phase = TaskPhase::kNone;
+  double task_start_wall = 0;
   double last_task_publish_wall = -1e9;
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
@@ -482,8 +483,8 @@ struct SimServer::Impl {
         sc.range_m().assign(ranges.begin(), ranges.end());
         sc.hit().assign(hits.begin(), hits.end());
       }
+      // A drone in failsafe (its agent lost) no longer counts for the task.
       if (failsafe_since[i] < 0) positions.push_back(st.p_world);
-      else if (referee.running()) {}  // a drone in failsafe no longer counts for the task
     }
     for (auto& b : swarm_msg.beacons()) b.true_position(swarm_msg.drones()[b.drone_id()].position());
     bool task_changed = referee.update(t, positions, cfg.sim.task_timeout_s);
@@ -533,8 +534,6 @@ struct SimServer::Impl {
                    r.min_inter_drone_m, r.min_clearance_m);
     if (changed && r.phase == TaskPhase::kFailed) spdlog::warn("task failed: {}", r.reason);
   }
-  double task_start_wall = 0;
-
   void publish_status(bool force) {
     double now = wall_seconds();
     if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz) return;

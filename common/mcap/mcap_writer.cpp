@@ -160,11 +160,7 @@ void Writer::flush_file() {
   if (std::fflush(file_) != 0) fail("flush failed", errno);
 }
 
-std::uint16_t Writer::add_schema(const std::string& name, const std::string& encoding,
-                                 const std::string& data) {
-  check_usable();
-  if (schemas_.size() >= 0xFFFF) throw std::length_error("mcap: " + path_ + ": too many schemas");
-  SchemaRec s{std::uint16_t(schemas_.size() + 1), name, encoding, data};
+void Writer::encode(const SchemaRec& s) {
   scratch_.clear();
   auto at = begin_record(scratch_, Op::schema);
   put_u16(scratch_, s.id);
@@ -172,20 +168,9 @@ std::uint16_t Writer::add_schema(const std::string& name, const std::string& enc
   put_str(scratch_, s.encoding);
   put_str(scratch_, s.data);  // uint32 length-prefixed bytes: same layout as a string
   end_record(scratch_, at);
-  emit(scratch_);
-  schemas_.push_back(std::move(s));
-  return schemas_.back().id;
 }
 
-std::uint16_t Writer::add_channel(std::uint16_t schema_id, const std::string& topic,
-                                  const std::string& message_encoding,
-                                  const std::map<std::string, std::string>& metadata) {
-  check_usable();
-  if (schema_id > schemas_.size())
-    throw std::invalid_argument("mcap: " + path_ + ": channel '" + topic + "' names schema id " +
-                                std::to_string(schema_id) + ", which was never added");
-  if (channels_.size() >= 0xFFFF) throw std::length_error("mcap: " + path_ + ": too many channels");
-  ChannelRec c{std::uint16_t(channels_.size() + 1), schema_id, topic, message_encoding, metadata};
+void Writer::encode(const ChannelRec& c) {
   scratch_.clear();
   auto at = begin_record(scratch_, Op::channel);
   put_u16(scratch_, c.id);
@@ -200,6 +185,29 @@ std::uint16_t Writer::add_channel(std::uint16_t schema_id, const std::string& to
   put_u32(scratch_, std::uint32_t(map.size()));
   scratch_.insert(scratch_.end(), map.begin(), map.end());
   end_record(scratch_, at);
+}
+
+std::uint16_t Writer::add_schema(const std::string& name, const std::string& encoding,
+                                 const std::string& data) {
+  check_usable();
+  if (schemas_.size() >= 0xFFFF) throw std::length_error("mcap: " + path_ + ": too many schemas");
+  SchemaRec s{std::uint16_t(schemas_.size() + 1), name, encoding, data};
+  encode(s);
+  emit(scratch_);
+  schemas_.push_back(std::move(s));
+  return schemas_.back().id;
+}
+
+std::uint16_t Writer::add_channel(std::uint16_t schema_id, const std::string& topic,
+                                  const std::string& message_encoding,
+                                  const std::map<std::string, std::string>& metadata) {
+  check_usable();
+  if (schema_id > schemas_.size())
+    throw std::invalid_argument("mcap: " + path_ + ": channel '" + topic + "' names schema id " +
+                                std::to_string(schema_id) + ", which was never added");
+  if (channels_.size() >= 0xFFFF) throw std::length_error("mcap: " + path_ + ": too many channels");
+  ChannelRec c{std::uint16_t(channels_.size() + 1), schema_id, topic, message_encoding, metadata};
+  encode(c);
   emit(scratch_);
   channels_.push_back(std::move(c));
   next_sequence_.push_back(0);
@@ -370,33 +378,14 @@ void Writer::close() {
 
     std::uint64_t start = offset_;
     for (const auto& s : schemas_) {
-      scratch_.clear();
-      at = begin_record(scratch_, Op::schema);
-      put_u16(scratch_, s.id);
-      put_str(scratch_, s.name);
-      put_str(scratch_, s.encoding);
-      put_str(scratch_, s.data);
-      end_record(scratch_, at);
+      encode(s);
       emit(scratch_);
     }
     group(Op::schema, start);
 
     start = offset_;
     for (const auto& c : channels_) {
-      scratch_.clear();
-      at = begin_record(scratch_, Op::channel);
-      put_u16(scratch_, c.id);
-      put_u16(scratch_, c.schema_id);
-      put_str(scratch_, c.topic);
-      put_str(scratch_, c.message_encoding);
-      std::vector<std::uint8_t> map;
-      for (const auto& [k, v] : c.metadata) {
-        put_str(map, k);
-        put_str(map, v);
-      }
-      put_u32(scratch_, std::uint32_t(map.size()));
-      scratch_.insert(scratch_.end(), map.begin(), map.end());
-      end_record(scratch_, at);
+      encode(c);
       emit(scratch_);
     }
     group(Op::channel, start);

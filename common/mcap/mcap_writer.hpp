@@ -125,6 +125,9 @@ class Writer {
     std::uint64_t index_length, compressed_size, uncompressed_size;
   };
 
+  /// Schema / Channel record into scratch_ (data section and summary alike).
+  void encode(const SchemaRec& s);
+  void encode(const ChannelRec& c);
   void emit(const std::uint8_t* p, std::size_t n);
   void emit(const std::vector<std::uint8_t>& v) { emit(v.data(), v.size()); }
   void flush_file();
