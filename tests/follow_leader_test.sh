@@ -4,9 +4,9 @@
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/tests/scenarios/scattered.yaml"
 gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
-# Each teleop is its own process here (~0.5 s apart): give the link 3 s before it lapses.
+# Each teleop is its own process here (0.5-2 s apart under load): give the link 5 s before it lapses.
 start launch "$BIN/ddswarm-launch" "$scenario" --mode realtime --domain "$DOMAIN" --drones 4 \
-  --set agent.teleop_timeout_s=3 --log-dir "$WORK/logs"
+  --set agent.teleop_timeout_s=5 --log-dir "$WORK/logs"
 gs wait-agents --count 4 --timeout 60 || fail "agents not online"
 gs takeoff --wait || fail "takeoff"
 gs hold --time 5 --wait || fail "hold"
@@ -15,13 +15,15 @@ centroid() {  # prints "leader_y centroid_y"
 }
 read l0 c0 < <(centroid)
 gs follow --leader 0 || fail "follow"
-# Fly the leader north at 1 m/s for ~8 s: teleop lapses after 1 s without news, so keep it fresh.
-end=$((SECONDS + 8))
+# Fly the leader north at 1 m/s for ~12 s, keeping the teleop link fresh.
+end=$((SECONDS + 12))
 while [ $SECONDS -lt $end ]; do gs teleop --north 1.0 >/dev/null || fail "teleop"; sleep 0.3; done
 read l1 c1 < <(centroid)
 echo "leader y $l0 -> $l1, swarm centroid y $c0 -> $c1"
 awk -v a="$l0" -v b="$l1" 'BEGIN{exit !(b - a > 4.0)}' || fail "the leader did not fly north"
-awk -v a="$c0" -v b="$c1" 'BEGIN{exit !(b - a > 3.0)}' || fail "the swarm did not follow its leader"
+# Followers cover at least half the leader's way (the centroid includes the leader).
+awk -v a="$l0" -v b="$l1" -v c="$c0" -v d="$c1" 'BEGIN{exit !(d - c > 0.5 * (b - a))}' \
+  || fail "the swarm did not follow its leader"
 gs hold >/dev/null || fail "hold after follow"
 gs status --drones
 echo PASS
