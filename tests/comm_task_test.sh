@@ -8,7 +8,7 @@ run() {  # run TAG SET...: flies the task, leaves the result line in $WORK/TAG.r
   local args=()
   for kv in "$@"; do args+=(--set "$kv"); done
   timeout 300 "$BIN/ddswarm-launch" "$SRC/config/thesis_course.yaml" --mode lockstep --domain "$DOMAIN" \
-    --seed 21 --log-dir "$WORK/logs-$tag" "${args[@]}" \
+    --seed 21 --log-dir "$WORK/logs-$tag" "${args[@]}" --set sim.agent_timeout_s=5 \
     --gs "takeoff --wait; task --csv $WORK/comm.csv" >"$WORK/$tag.log" 2>&1
   local rc=$?
   cat "$WORK/$tag.log"

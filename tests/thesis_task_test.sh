@@ -6,7 +6,7 @@ source "$(dirname "$0")/lib.sh"
 speed="${1:-0.8}"
 started=$SECONDS
 timeout 240 "$BIN/ddswarm-launch" "$SRC/config/thesis_course.yaml" --mode lockstep --domain "$DOMAIN" \
-  --log-dir "$WORK/logs" --gs "takeoff --wait; task --speed $speed --csv $WORK/result.csv" >"$WORK/launch.log" 2>&1
+  --set sim.agent_timeout_s=5 --log-dir "$WORK/logs" --gs "takeoff --wait; task --speed $speed --csv $WORK/result.csv" >"$WORK/launch.log" 2>&1
 rc=$?
 cat "$WORK/launch.log"
 cp "$WORK"/logs/*.log "$WORK/" 2>/dev/null
