@@ -33,8 +33,7 @@ void ServerConfig::validate() const {
 }
 
 ServerConfig load_server_config(const std::string& path) {
-  auto doc = YamlDocument::load_file(path);
-  check_sections(doc);
+  auto doc = load_scenario(path);
   ServerConfig c;
   doc.guard([&] {
     load(doc.section("scenario"), c.scenario);
@@ -120,6 +119,12 @@ struct SimServer::Impl {
   double start_wall = 0;
   TaskPhase last_task_phase = TaskPhase::kNone;
   double task_start_wall = 0;
+  // Per-tick scratch, allocated once (publish_tick is on every tick's path).
+  std::vector<float> ranges;
+  std::vector<std::uint8_t> hits;
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<char> tick_live;
+  std::vector<Phase> tick_phase;
   double last_task_publish_wall = -1e9;
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
@@ -154,6 +159,9 @@ struct SimServer::Impl {
     coll_drone.assign(n, 0);
     coll_ground.assign(n, 0);
     cmd_age_s.assign(n, 0.f);
+    tick_live.assign(n, 0);
+    tick_phase.assign(n, Phase::kIdle);
+    positions.reserve(n);
     swarm_msg.drones().resize(n);
     swarm_msg.scans().resize(n);
     for (int i = 0; i < n; ++i) {
@@ -424,11 +432,14 @@ struct SimServer::Impl {
   void publish_tick() {
     const double t = sim_time();
     const bool scan_tick = tick % static_cast<std::uint64_t>(cfg.sim.sensor_every()) == 0;
-    std::vector<float> ranges;
-    std::vector<std::uint8_t> hits;
-    std::vector<Eigen::Vector3d> positions;
+    positions.clear();
     {
       std::lock_guard<std::mutex> lock(mu);
+      // What the callbacks keep per drone, read once for the whole tick.
+      for (int i = 0; i < n; ++i) {
+        tick_live[i] = slots[i].live;
+        tick_phase[i] = slots[i].phase;
+      }
       release_mission();
       swarm_msg.recent_commands().assign(recent.begin(), recent.end());
       // The radio medium: beacons sent last tick, in drone order, with the
@@ -461,12 +472,8 @@ struct SimServer::Impl {
       bool airborne = st.p_world.z() > cfg.scene.ground_z_m + cfg.sim.airborne_height_m;
       if (airborne) flags |= msg::DRONE_AIRBORNE;
       if (failsafe_since[i] >= 0) flags |= msg::DRONE_FAILSAFE;
-      Phase phase;
-      {
-        std::lock_guard<std::mutex> lock(mu);
-        if (slots[i].live) flags |= msg::DRONE_AGENT_LIVE;
-        phase = slots[i].phase;
-      }
+      if (tick_live[i]) flags |= msg::DRONE_AGENT_LIVE;
+      const Phase phase = tick_phase[i];
       if ((st.p_world.array() < cfg.scene.bounds_min.array()).any() ||
           (st.p_world.array() > cfg.scene.bounds_max.array()).any())
         flags |= msg::DRONE_OUT_OF_BOUNDS;
