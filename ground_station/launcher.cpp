@@ -190,13 +190,6 @@ int Launcher::running() const {
   return static_cast<int>(live_.size());
 }
 
-std::vector<std::pair<std::string, pid_t>> Launcher::children() const {
-  std::lock_guard<std::mutex> lock(mu_);
-  std::vector<std::pair<std::string, pid_t>> out;
-  for (const auto& [pid, c] : live_) out.emplace_back(c->name, pid);
-  return out;
-}
-
 bool Launcher::signal(const std::string& name, int sig) {
   std::lock_guard<std::mutex> lock(mu_);
   for (const auto& [pid, c] : live_)

@@ -46,7 +46,6 @@ class Launcher {
   std::vector<ChildExit> stop_all(double grace_s = 3.0);
   /// Sends sig to one child by name (tests, fault injection).
   bool signal(const std::string& name, int sig);
-  std::vector<std::pair<std::string, pid_t>> children() const;
 
   /// Directory of the running executable (where the sibling binaries live).
   static std::string self_dir();
