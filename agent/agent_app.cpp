@@ -32,8 +32,7 @@ void AgentAppConfig::validate() const {
 }
 
 AgentAppConfig load_agent_config(const std::string& path) {
-  auto doc = YamlDocument::load_file(path);
-  check_sections(doc);
+  auto doc = load_scenario(path);
   AgentAppConfig c;
   doc.guard([&] {
     load(doc.section("scenario"), c.scenario);

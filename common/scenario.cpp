@@ -32,4 +32,10 @@ void check_sections(const YamlDocument& doc) {
   }
 }
 
+YamlDocument load_scenario(const std::string& path) {
+  auto doc = YamlDocument::load_file(path);
+  check_sections(doc);
+  return doc;
+}
+
 }  // namespace ddswarm

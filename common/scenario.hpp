@@ -25,4 +25,7 @@ void load(YamlSection s, ScenarioConfig& c);
 /// owns strictly and checks that no unknown section is present.
 void check_sections(const YamlDocument& doc);
 
+/// Loads a scenario file and checks its top-level sections (ConfigError otherwise).
+YamlDocument load_scenario(const std::string& path);
+
 }  // namespace ddswarm

@@ -7,8 +7,7 @@ namespace ddswarm::gs {
 GsFileConfig load_gs_config(const std::string& path) {
   GsFileConfig c;
   if (path.empty()) return c;
-  auto doc = YamlDocument::load_file(path);
-  check_sections(doc);
+  auto doc = load_scenario(path);
   doc.guard([&] {
     ScenarioConfig sc;
     load(doc.section("scenario"), sc);
