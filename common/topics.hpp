@@ -36,7 +36,7 @@ DDSWARM_TOPIC(TaskStatus, "ddswarm/task", "latched");
 DDSWARM_TOPIC(VelocityCommand, "ddswarm/velocity_cmd", "command");
 DDSWARM_TOPIC(AgentStatus, "ddswarm/agent_status", "heartbeat");
 DDSWARM_TOPIC(MissionCommand, "ddswarm/mission", "mission");
-DDSWARM_TOPIC(MissionAck, "ddswarm/mission_ack", "events");
+DDSWARM_TOPIC(MissionAck, "ddswarm/mission_ack", "ack");
 DDSWARM_TOPIC(Beacon, "ddswarm/beacon", "state_keyed");
 
 #undef DDSWARM_TOPIC

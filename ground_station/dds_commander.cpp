@@ -52,6 +52,7 @@ struct DdsCommander::Impl {
   std::map<std::uint32_t, std::map<int, msg::MissionAck>> acks;  // seq -> drone -> ack
   std::uint32_t seq = 0;
   std::uint32_t task_seq = 0;
+  double last_command_wall = -1e9;  // when the latest command was sent
   Reader<msg::MissionAck>* ack_reader = nullptr;
   std::optional<TaskOutcome> outcome;
 
@@ -147,6 +148,7 @@ struct DdsCommander::Impl {
     }
     msg::MissionCommand m = to_msg(c);
     m.issuer_instance(instance);
+    last_command_wall = wall_seconds();
     lock.unlock();
     if (!w_mission.write(m)) return {false, "DDS refused the command"};
     lock.lock();
@@ -240,8 +242,13 @@ bool DdsCommander::wait_airborne(int count, double timeout_s) {
 bool DdsCommander::wait_takeoff_done(int count, double timeout_s) {
   return impl_->wait(timeout_s, [&] {
     if (!impl_->sim || impl_->sim->airborne() < count) return false;
-    for (int id : impl_->online_locked())
-      if (impl_->agents.count(id) && impl_->agents.at(id).phase == Phase::kTakeoff) return false;
+    // Only a heartbeat sent after the command tells the agent's phase now: in
+    // lockstep a whole climb can pass between two heartbeats.
+    for (int id : impl_->online_locked()) {
+      auto it = impl_->agents.find(id);
+      if (it == impl_->agents.end() || it->second.wall <= impl_->last_command_wall) return false;
+      if (it->second.phase == Phase::kTakeoff || it->second.phase == Phase::kIdle) return false;
+    }
     return true;
   });
 }

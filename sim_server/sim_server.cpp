@@ -288,11 +288,8 @@ struct SimServer::Impl {
     }
   }
 
-  /// Releases at most one pending mission command onto this tick. Call with mu held.
-  void release_mission() {
-    if (pending_missions.empty()) return;
-    msg::MissionCommand m = pending_missions.front();
-    pending_missions.pop_front();
+  /// Puts a command into the ring carried by every SwarmState, stamped with this tick.
+  void forward(msg::MissionCommand m) {
     m.apply_tick(tick);
     // One entry per command in the ring, or agents would see it alternate between apply ticks.
     std::erase_if(recent, [&](const msg::MissionCommand& r) {
@@ -300,10 +297,24 @@ struct SimServer::Impl {
     });
     recent.push_back(m);
     while (recent.size() > 8) recent.pop_front();
+  }
+
+  /// Releases at most one new pending mission command onto this tick; repeats
+  /// go into the ring too but take no slot, so a re-sent command never delays
+  /// the next one (lockstep determinism). Call with mu held.
+  void release_mission() {
+    while (!pending_missions.empty() &&
+           released_missions.count({pending_missions.front().issuer_instance(), pending_missions.front().seq()})) {
+      forward(pending_missions.front());
+      pending_missions.pop_front();
+    }
+    if (pending_missions.empty()) return;
+    msg::MissionCommand m = pending_missions.front();
+    pending_missions.pop_front();
+    forward(m);
     auto type = static_cast<MissionType>(m.type());
     spdlog::info("tick {}: mission seq {} {} released", tick, m.seq(), to_string(type));
-    // A repeat only gathers acknowledgements again; its effects happened the first time.
-    if (!released_missions.insert({m.issuer_instance(), m.seq()}).second) return;
+    released_missions.insert({m.issuer_instance(), m.seq()});
     if (type == MissionType::kSetDistance) d_int = m.value();
     if (referee.running() && (type == MissionType::kLand || type == MissionType::kTask ||
                               type == MissionType::kMove || type == MissionType::kFollowLeader))
