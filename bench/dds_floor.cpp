@@ -1,0 +1,315 @@
+// dds_floor: the lockstep floor that Fast DDS sets on this machine (issue 8).
+//
+// One process publishes a whole-swarm msg::SwarmState with N drones and their
+// scans (the size ddswarm's server publishes); N responder processes (this
+// binary, --respond ID) each answer with one msg::VelocityCommand from inside
+// the DDS callback, as ddswarm's agents do; once all N have answered, the next
+// tick goes out. Same Participant, transports (localhost only) and QoS
+// profiles as ddswarm. Measures discovery time, idle CPU after discovery and
+// ticks/s after a warm-up, with simple discovery and with the Fast DDS
+// discovery server.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "bench/bench_util.hpp"
+#include "common/participant.hpp"
+#include "common/process.hpp"
+
+using namespace ddswarm;
+using namespace ddswarm::bench;
+
+namespace {
+
+constexpr int kRays = 8;  // config/thesis_course.yaml sensors.count
+
+msg::SwarmState make_state(int n) {
+  msg::SwarmState s;
+  s.drones().resize(n);
+  s.scans().resize(n);
+  for (int i = 0; i < n; ++i) {
+    auto& d = s.drones()[i];
+    d.drone_id(static_cast<std::uint16_t>(i));
+    d.position().x(i * 1.5);
+    d.orientation().w(1.0);
+    auto& sc = s.scans()[i];
+    sc.drone_id(static_cast<std::uint16_t>(i));
+    sc.max_range_m(6.0f);
+    for (int k = 0; k < kRays; ++k) {
+      sc.angle_body_rad().push_back(static_cast<float>(2 * M_PI * k / kRays));
+      sc.range_m().push_back(6.0f);
+      sc.hit().push_back(0);
+    }
+  }
+  return s;
+}
+
+DdsConfig dds_for(int domain, const std::string& server) {
+  DdsConfig c;
+  c.domain_id = domain;
+  if (!server.empty()) {
+    c.discovery = Discovery::kDiscoveryServer;
+    c.discovery_server = server;
+  }
+  return c;
+}
+
+/// Responder: answers every SwarmState with one VelocityCommand, inside the callback.
+int respond(int id, int domain, const std::string& server, double duration_s) {
+  install_stop_signals();
+  Participant p(dds_for(domain, server), "dds_floor responder " + std::to_string(id));
+  auto w = p.writer<msg::VelocityCommand>();
+  msg::VelocityCommand cmd;
+  cmd.drone_id(static_cast<std::uint16_t>(id));
+  cmd.motors_on(true);
+  p.reader<msg::SwarmState>([&](const msg::SwarmState& s, const fdds::SampleInfo&) {
+    // Read what an agent reads: its own state and every peer's position.
+    double sx = 0;
+    for (const auto& d : s.drones()) sx += d.position().x();
+    cmd.tick(s.tick());
+    cmd.sim_time_s(s.sim_time_s());
+    cmd.velocity().x(id < static_cast<int>(s.drones().size()) ? -sx * 1e-6 : 0);
+    w.write(cmd);
+  });
+  wait_for_stop(std::chrono::duration<double>(duration_s));
+  p.close();
+  return 0;
+}
+
+struct Result {
+  int n = 0;
+  std::string discovery;
+  bool ok = false;
+  std::string why;
+  double discovery_s = NAN, idle_cores = NAN, busy_cores = NAN, ticks_per_s = NAN;
+  long ticks = 0;
+  double responder_rss_mb = NAN;
+  int responder_threads = 0;
+};
+
+double cpu_of(const std::map<pid_t, ProcSample>& m) {
+  double s = 0;
+  for (const auto& [p, x] : m) s += x.cpu_s;
+  return s;
+}
+
+/// CPU seconds used between two samples, by the processes present in both.
+double cpu_between(const std::map<pid_t, ProcSample>& a, const std::map<pid_t, ProcSample>& b) {
+  double s = 0;
+  for (const auto& [p, x] : b)
+    if (auto it = a.find(p); it != a.end()) s += x.cpu_s - it->second.cpu_s;
+  return s;
+}
+
+Result run_one(int n, bool use_server, int domain, double warmup_s, double measure_s, double idle_s,
+               double discovery_timeout_s, const std::string& log_dir) {
+  Result r;
+  r.n = n;
+  r.discovery = use_server ? "server" : "simple";
+  std::vector<pid_t> kids;
+  std::string server;
+  const double t0 = wall_seconds();
+  if (use_server) {
+    int port = free_udp_port();
+    server = fmt::format("127.0.0.1:{}", port);
+    kids.push_back(start_discovery_server(port, log_dir.empty() ? "" : log_dir + "/ds.log"));
+  }
+  const double child_budget = discovery_timeout_s + warmup_s + measure_s + idle_s + 30;
+  for (int i = 0; i < n; ++i) {
+    std::vector<std::string> a = {self_exe(), "--respond", std::to_string(i), "--domain", std::to_string(domain),
+                                  "--duration", fmt::format("{:.0f}", child_budget)};
+    if (use_server) {
+      a.push_back("--discovery-server");
+      a.push_back(server);
+    }
+    kids.push_back(spawn(a, log_dir.empty() ? "" : fmt::format("{}/responder-{}.log", log_dir, i)));
+  }
+  std::vector<pid_t> all = kids;
+  all.push_back(getpid());
+  {
+    Participant p(dds_for(domain, server), "dds_floor publisher");
+    auto w = p.writer<msg::SwarmState>();
+    std::mutex mu;
+    std::condition_variable cv;
+    std::uint64_t tick = 0;
+    std::vector<char> answered(n, 0);
+    int count = 0;
+    auto& rd = p.reader<msg::VelocityCommand>([&](const msg::VelocityCommand& c, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(mu);
+      if (c.tick() != tick || c.drone_id() >= n || answered[c.drone_id()]) return;
+      answered[c.drone_id()] = 1;
+      if (++count == n) cv.notify_all();
+    });
+    // Discovery: every responder's reader and writer matched with ours.
+    while (!stop_requested() && (w.matched() < n || rd.matched() < n) && wall_seconds() - t0 < discovery_timeout_s)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    r.discovery_s = wall_seconds() - t0;
+    if (w.matched() < n || rd.matched() < n) {
+      r.why = fmt::format("discovery incomplete after {:.0f} s: {}/{} readers, {}/{} writers matched",
+                          r.discovery_s, w.matched(), n, rd.matched(), n);
+    } else {
+      // Idle cost once discovered: the participants' announcements and liveliness.
+      auto a = sample_all(all);
+      wait_for_stop(std::chrono::duration<double>(idle_s));
+      r.idle_cores = cpu_between(a, sample_all(all)) / idle_s;
+
+      msg::SwarmState s = make_state(n);
+      auto publish = [&](std::uint64_t k) {
+        s.tick(k);
+        s.sim_time_s(k * 0.02);
+        w.write(s);
+      };
+      // Lockstep; re-publish a tick nobody answered within 0.25 s (a sample
+      // written before the match completed is lost for good: FASTDDS_NOTES trap 1).
+      long ticks = 0;
+      bool measuring = false;
+      double t_measure = 0;
+      std::map<pid_t, ProcSample> cpu0;
+      const double t_start = wall_seconds();
+      publish(0);
+      while (!stop_requested()) {
+        std::unique_lock<std::mutex> lock(mu);
+        if (!cv.wait_for(lock, std::chrono::milliseconds(250), [&] { return count == n; })) {
+          lock.unlock();
+          if (wall_seconds() - t_start > warmup_s + measure_s + 30) {
+            r.why = fmt::format("tick {} unanswered by {} responder(s)", tick, n - count);
+            break;
+          }
+          publish(tick);
+          continue;
+        }
+        ++tick;
+        count = 0;
+        std::fill(answered.begin(), answered.end(), 0);
+        lock.unlock();
+        const double now = wall_seconds();
+        if (!measuring && now - t_start >= warmup_s) {
+          measuring = true;
+          t_measure = now;
+          ticks = 0;
+          cpu0 = sample_all(all);
+        } else if (measuring) {
+          ++ticks;
+          if (now - t_measure >= measure_s) {
+            const double dt = now - t_measure;
+            r.busy_cores = cpu_between(cpu0, sample_all(all)) / dt;
+            r.ticks = ticks;
+            r.ticks_per_s = ticks / dt;
+            r.ok = true;
+            break;
+          }
+        }
+        publish(tick);
+      }
+      auto procs = sample_all(kids, false);
+      double rss = 0;
+      int m = 0;
+      for (const auto& [pid, x] : procs)
+        if (x.comm == "dds_floor") {
+          rss += x.rss_kb;
+          r.responder_threads = x.threads;
+          ++m;
+        }
+      if (m) r.responder_rss_mb = rss / m / 1024.0;
+    }
+    p.close();
+  }
+  stop_all(kids);
+  (void)cpu_of;
+  return r;
+}
+
+std::string fmt_num(double v, const char* f) { return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : "-"; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_main("dds_floor", [&]() -> int {
+    CLI::App app{"dds_floor: the bare Fast DDS lockstep floor (one whole-swarm sample out, N answers back)"};
+    std::vector<int> sizes = {6, 16, 32, 64, 128};
+    std::string discovery = "both", csv, log_dir;
+    double warmup_s = 2, measure_s = 5, idle_s = 2, discovery_timeout_s = 120, duration_s = 600;
+    int simple_max = 64, domain = -1, respond_id = -1;
+    std::string server;
+    app.add_option("--drones", sizes, "swarm sizes to measure")->delimiter(',');
+    app.add_option("--discovery", discovery, "simple | server | both")
+        ->check(CLI::IsMember({"simple", "server", "both"}));
+    app.add_option("--simple-max", simple_max,
+                   "largest N run with simple discovery (N=128 takes ~90 s to discover, and more than "
+                   "~100 participants need explicit ids)");
+    app.add_option("--warmup", warmup_s, "s of lockstep before measuring");
+    app.add_option("--time", measure_s, "s of lockstep measured");
+    app.add_option("--idle", idle_s, "s of idle CPU measured after discovery");
+    app.add_option("--discovery-timeout", discovery_timeout_s, "s to wait for discovery");
+    app.add_option("--domain", domain, "DDS domain (default: random in 100-199)");
+    app.add_option("--csv", csv, "append one row per run to this CSV");
+    app.add_option("--log-dir", log_dir, "responder and discovery-server logs (default: discarded)");
+    app.add_option("--respond", respond_id, "internal: run as responder ID")->group("");
+    app.add_option("--discovery-server", server, "internal: responder's discovery server")->group("");
+    app.add_option("--duration", duration_s, "internal: responder's lifetime (s)")->group("");
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      return app.exit(e) == 0 ? 0 : 2;
+    }
+    if (domain < 0) domain = 100 + static_cast<int>(random_instance() % 100);
+    if (respond_id >= 0) return respond(respond_id, domain, server, duration_s);
+    install_stop_signals();
+    if (!log_dir.empty()) std::filesystem::create_directories(log_dir);
+
+    std::vector<Result> results;
+    for (int n : sizes) {
+      for (bool use_server : {false, true}) {
+        if (stop_requested()) break;
+        if (use_server && discovery == "simple") continue;
+        if (!use_server && discovery == "server") continue;
+        if (!use_server && n > simple_max) {
+          Result r;
+          r.n = n;
+          r.discovery = "simple";
+          r.why = fmt::format("skipped (--simple-max {})", simple_max);
+          results.push_back(r);
+          continue;
+        }
+        std::fprintf(stderr, "dds_floor: N=%d, %s discovery ...\n", n, use_server ? "server" : "simple");
+        Result r = run_one(n, use_server, domain, warmup_s, measure_s, idle_s, discovery_timeout_s, log_dir);
+        std::fprintf(stderr, "dds_floor: N=%d %s: %s\n", n, r.discovery.c_str(),
+                     r.ok ? fmt::format("{:.0f} ticks/s", r.ticks_per_s).c_str() : r.why.c_str());
+        results.push_back(r);
+      }
+    }
+    std::printf("\n== bare Fast DDS lockstep floor: 1 publisher of a whole-swarm SwarmState, N responder "
+                "processes; %.0f s warm-up, %.0f s measured ==\n",
+                warmup_s, measure_s);
+    std::printf("| N | discovery | ticks/s | discovery time (s) | idle CPU (cores) | CPU while ticking (cores) | "
+                "responder RSS (MB) | responder threads | note |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|\n");
+    for (const auto& r : results)
+      std::printf("| %d | %s | %s | %s | %s | %s | %s | %s | %s |\n", r.n, r.discovery.c_str(),
+                  fmt_num(r.ticks_per_s, "{:.0f}").c_str(), fmt_num(r.discovery_s, "{:.1f}").c_str(),
+                  fmt_num(r.idle_cores, "{:.2f}").c_str(), fmt_num(r.busy_cores, "{:.2f}").c_str(),
+                  fmt_num(r.responder_rss_mb, "{:.1f}").c_str(),
+                  r.responder_threads ? std::to_string(r.responder_threads).c_str() : "-", r.why.c_str());
+    if (!csv.empty()) {
+      bool fresh = !std::filesystem::exists(csv);
+      std::ofstream f(csv, std::ios::app);
+      if (fresh) f << "n,discovery,ok,ticks_per_s,discovery_s,idle_cores,busy_cores,responder_rss_mb,note\n";
+      for (const auto& r : results)
+        f << r.n << "," << r.discovery << "," << (r.ok ? 1 : 0) << "," << r.ticks_per_s << "," << r.discovery_s
+          << "," << r.idle_cores << "," << r.busy_cores << "," << r.responder_rss_mb << ",\"" << r.why << "\"\n";
+    }
+    bool any_fail = false;
+    for (const auto& r : results)
+      if (!r.ok && r.why.rfind("skipped", 0) != 0) any_fail = true;
+    return any_fail ? 1 : 0;
+  });
+}
