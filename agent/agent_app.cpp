@@ -83,6 +83,9 @@ struct AgentApp::Impl {
   std::mutex mu;  // guards everything below (DDS callbacks run on Fast DDS threads)
   std::optional<SceneConfig> scene;
   eprosima::fastrtps::rtps::GuidPrefix_t server;  // the scene's publisher
+  std::uint64_t server_instance = 0;              // its Scene.server_instance
+  double control_period_s = 0.02;
+  bool caught_up = false;  // the mission in force (the ring) was taken from the first sample
   std::unique_ptr<MissionFsm> fsm;
   TruthPeerSource truth;
   std::unique_ptr<ModelledPeerSource> modelled;  // when comm asks for more than exact truth
@@ -105,21 +108,16 @@ struct AgentApp::Impl {
   std::vector<float> ranges, angles;
   std::vector<std::uint8_t> hits;
 
-  static std::uint64_t make_instance() {
-    std::random_device rd;
-    std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^ static_cast<std::uint64_t>(getpid());
-    return v ? v : 1;
-  }
-
   // DDS callbacks touch the members below: stop them before anything is destroyed.
   ~Impl() { dds.close(); }
 
   explicit Impl(AgentAppConfig c)
       : cfg(std::move(c)),
         id(cfg.drone_id),
-        instance(make_instance()),
+        instance(random_instance()),
         dds(cfg.dds, "ddswarm-agent-" + std::to_string(cfg.drone_id)),
-        w_cmd(dds.writer<msg::VelocityCommand>()),
+        // Under DDS Security only agent-K may publish in drone K's partition.
+        w_cmd(dds.writer<msg::VelocityCommand>(cfg.dds.secure() ? drone_partition(cfg.drone_id) : "")),
         w_status(dds.writer<msg::AgentStatus>()),
         w_ack(dds.writer<msg::MissionAck>()),
         w_beacon(dds.writer<msg::Beacon>()) {
@@ -138,7 +136,24 @@ struct AgentApp::Impl {
         spdlog::error("drone {}: the server flies only {} drones", id, s.num_drones());
         return;
       }
-      if (fsm) return;  // keep the mission across a server's re-announcement
+      if (fsm && s.server_instance() == server_instance) return;  // a re-announcement: keep the mission
+      if (fsm) {
+        // A restarted server is a new world: the drone is back at its start,
+        // so the old mission no longer applies. Start over and catch up with
+        // whatever the new server's ring says.
+        spdlog::warn("drone {}: new server instance {:016x} (was {:016x}): mission reset", id,
+                     s.server_instance(), server_instance);
+        fsm.reset();
+        modelled.reset();
+        peers = &truth;
+        seen_missions.clear();
+        seen_order.clear();
+        have_tick = false;
+        fed_tick = ~0ULL;
+      }
+      server_instance = s.server_instance();
+      control_period_s = 1.0 / s.control_rate_hz();
+      caught_up = false;
       scene = scene_from_msg(s);
       fsm = std::make_unique<MissionFsm>(id, cfg.agent, *scene);
       if (!cfg.comm.ideal()) {
@@ -235,6 +250,10 @@ struct AgentApp::Impl {
     obs.v_world = from_msg(me.velocity());
     obs.on_ground = obs.p_world.z() < scene->ground_z_m + 0.15 && obs.v_world.norm() < 0.5;
 
+    // The first sample after joining: commands the swarm applied before this
+    // agent was here are caught up with (a restarted agent rejoins its mission).
+    const bool joining = !caught_up;
+    caught_up = true;
     for (const auto& m : s.recent_commands()) {
       const auto key = std::make_pair(m.issuer_instance(), m.seq());
       auto it = seen_missions.find(key);
@@ -258,6 +277,14 @@ struct AgentApp::Impl {
         continue;
       }
       if (!fsm->addressed_to_me(c)) continue;
+      if (joining && m.apply_tick() < s.tick()) {
+        MissionAck a = fsm->resume(c, static_cast<double>(m.apply_tick()) * control_period_s, obs);
+        last_mission_seq = m.seq();
+        w_ack.write(to_msg(a, m.issuer_instance()));
+        spdlog::info("drone {}: joined mid-mission: caught up with {} seq {} of tick {}{}", id,
+                     to_string(c.type), c.seq, m.apply_tick(), a.accepted ? "" : ": " + a.reason);
+        continue;
+      }
       MissionAck a = fsm->apply(c, obs);
       last_mission_seq = m.seq();
       w_ack.write(to_msg(a, m.issuer_instance()));

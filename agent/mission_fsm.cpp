@@ -72,6 +72,108 @@ MissionAck MissionFsm::apply(const MissionCommand& c, const Observation& o) {
   return ack;
 }
 
+MissionAck MissionFsm::resume(const MissionCommand& c, double applied_at_s, const Observation& o) {
+  MissionAck ack;
+  ack.drone_id = static_cast<std::uint16_t>(id_);
+  ack.seq = c.seq;
+  ack.tick = o.tick;
+  ack.phase = phase_;
+  if (!addressed_to_me(c)) {
+    ack.reason = "addressed to drone " + std::to_string(c.target);
+    return ack;
+  }
+  auto& log = history_[c.issuer];
+  for (const auto& a : log)
+    if (a.command.seq == c.seq && same_command(a.command, c)) return a.ack;
+  highest_seq_[c.issuer] = std::max(highest_seq_[c.issuer], c.seq);
+  ack.reason = resume_execute(c, applied_at_s, o);
+  ack.accepted = ack.reason.empty();
+  ack.phase = phase_;
+  log.push_back({c, ack});
+  if (log.size() > kHistoryDepth) log.pop_front();
+  return ack;
+}
+
+void MissionFsm::enter(Phase p) {
+  if (phase_ == Phase::kTakeoff)
+    after_takeoff_ = p;
+  else
+    phase_ = p;
+}
+
+std::string MissionFsm::takeoff_altitude(const MissionCommand& c, double* z) const {
+  if (!std::isfinite(c.value) || c.value < 0) return "altitude must be >= 0 (0 = default)";
+  const double alt = c.value > 0 ? c.value : cfg_.takeoff_altitude_m;
+  if (alt < cfg_.min_altitude_m)
+    return "altitude " + to_text(alt) + " m is below agent.min_altitude_m (" +
+           to_text(cfg_.min_altitude_m) + ")";
+  *z = scene_.ground_z_m + alt;
+  if (*z > scene_.bounds_max.z() - cfg_.min_altitude_m)
+    return "altitude " + to_text(alt) + " m is above the world bounds";
+  return "";
+}
+
+std::string MissionFsm::resume_execute(const MissionCommand& c, double at_s, const Observation& o) {
+  const bool flying_mission = phase_ != Phase::kIdle && phase_ != Phase::kLanding;
+  switch (c.type) {
+    case MissionType::kTakeoff: {
+      double z = 0;
+      if (auto bad = takeoff_altitude(c, &z); !bad.empty()) return bad;
+      cruise_z_m_ = z;
+      phase_ = Phase::kTakeoff;  // climbs (or settles) to the cruise altitude, then holds
+      after_takeoff_ = Phase::kHold;
+      return "";
+    }
+    case MissionType::kLand:
+      phase_ = o.on_ground ? Phase::kIdle : Phase::kLanding;
+      return "";
+    case MissionType::kSetDistance:
+      return execute(c, o);
+    case MissionType::kMove: {
+      if (auto bad = check_velocity(c.velocity, cfg_.max_speed_mps); !bad.empty()) return bad;
+      if (!std::isfinite(c.duration_s) || c.duration_s <= 0) return "duration_s must be > 0";
+      if (!flying_mission) return "not airborne";
+      move_velocity_ = c.velocity;
+      move_end_s_ = at_s + c.duration_s;
+      enter(o.sim_time_s < move_end_s_ ? Phase::kMove : Phase::kHold);
+      return "";
+    }
+    case MissionType::kTask: {
+      if (!std::isfinite(c.value) || c.value < 0) return "speed must be >= 0 (0 = default)";
+      if (c.value > cfg_.max_speed_mps) return "speed exceeds agent.max_speed_mps";
+      if (!flying_mission) return "not airborne";
+      task_speed_mps_ = c.value > 0 ? c.value : cfg_.task_speed_mps;
+      enter(Phase::kTask);
+      return "";
+    }
+    case MissionType::kFollowLeader:
+      if (c.leader_id < 0) return "leader_id must be a drone id (>= 0)";
+      if (!flying_mission) return "not airborne";
+      leader_id_ = c.leader_id;
+      teleop_velocity_.setZero();
+      teleop_time_s_ = at_s;
+      enter(Phase::kFollow);
+      return "";
+    case MissionType::kHold:
+      if (!flying_mission) return "not airborne";
+      hold_end_s_ = at_s + c.duration_s;
+      enter(Phase::kHold);
+      return "";
+    case MissionType::kTeleop: {
+      if (auto bad = check_velocity(c.velocity, cfg_.max_speed_mps); !bad.empty()) return bad;
+      const bool following = phase_ == Phase::kFollow ||
+                             (phase_ == Phase::kTakeoff && after_takeoff_ == Phase::kFollow);
+      if (!following) return "not following a leader";
+      teleop_velocity_ = c.velocity;
+      teleop_time_s_ = at_s;
+      return "";
+    }
+    case MissionType::kNone:
+      break;
+  }
+  return "unknown command type";
+}
+
 std::string MissionFsm::execute(const MissionCommand& c, const Observation& o) {
   // Shared gate for the commands that need the drone up and free.
   auto gate = [&]() -> std::string {
@@ -83,17 +185,12 @@ std::string MissionFsm::execute(const MissionCommand& c, const Observation& o) {
 
   switch (c.type) {
     case MissionType::kTakeoff: {
-      if (!std::isfinite(c.value) || c.value < 0) return "altitude must be >= 0 (0 = default)";
-      const double alt = c.value > 0 ? c.value : cfg_.takeoff_altitude_m;
-      if (alt < cfg_.min_altitude_m)
-        return "altitude " + to_text(alt) + " m is below agent.min_altitude_m (" +
-               to_text(cfg_.min_altitude_m) + ")";
-      const double z = scene_.ground_z_m + alt;
-      if (z > scene_.bounds_max.z() - cfg_.min_altitude_m)
-        return "altitude " + to_text(alt) + " m is above the world bounds";
+      double z = 0;
+      if (auto bad = takeoff_altitude(c, &z); !bad.empty()) return bad;
       if (phase_ != Phase::kIdle && phase_ != Phase::kLanding) return "already airborne";
       cruise_z_m_ = z;
       phase_ = Phase::kTakeoff;
+      after_takeoff_ = Phase::kHold;
       return "";
     }
     case MissionType::kMove: {
@@ -162,7 +259,10 @@ MissionOutput MissionFsm::step(const Observation& o) {
 
   switch (phase_) {
     case Phase::kTakeoff:
-      if (std::abs(o.p_world.z() - cruise_z_m_) <= cfg_.altitude_tolerance_m) phase_ = Phase::kHold;
+      if (std::abs(o.p_world.z() - cruise_z_m_) <= cfg_.altitude_tolerance_m) {
+        phase_ = after_takeoff_;
+        after_takeoff_ = Phase::kHold;
+      }
       break;
     case Phase::kMove:
       if (o.sim_time_s >= move_end_s_) phase_ = Phase::kHold;

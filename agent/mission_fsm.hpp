@@ -80,6 +80,15 @@ class MissionFsm {
   /// applied and that issuer's history is forgotten.
   MissionAck apply(const MissionCommand& c, const Observation& o);
 
+  /// Catches up with a command the swarm applied at sim time applied_at_s,
+  /// before this agent (re)joined: the state it leaves is the one the drone
+  /// would be in had it applied c then (a move's end and a timed hold's end
+  /// count from applied_at_s). The gates of apply() do not hold, because the
+  /// drone may be anywhere (hovering or landed by the server's failsafe): a
+  /// flying phase entered while the drone is off its cruise altitude is
+  /// entered through takeoff, which climbs first. Idempotent like apply().
+  MissionAck resume(const MissionCommand& c, double applied_at_s, const Observation& o);
+
   /// Advances timed transitions and returns this tick's mission output. Call
   /// every control tick. busy: false in idle; true in takeoff, move, task,
   /// follow and landing; in hold only until a timed hold (duration_s) ends; false in
@@ -99,6 +108,11 @@ class MissionFsm {
 
   /// Empty when accepted (state changed), else the rejection reason (state unchanged).
   std::string execute(const MissionCommand& c, const Observation& o);
+  std::string resume_execute(const MissionCommand& c, double at_s, const Observation& o);
+  /// Enters a flying phase now, or after the climb when taking off.
+  void enter(Phase p);
+  /// "" and *z when c's takeoff altitude is usable, else why not.
+  std::string takeoff_altitude(const MissionCommand& c, double* z) const;
   double clamp_cruise(double z) const;
   bool airborne() const { return phase_ != Phase::kIdle; }
 
@@ -106,6 +120,7 @@ class MissionFsm {
   AgentConfig cfg_;
   ddswarm::SceneConfig scene_;
   Phase phase_ = Phase::kIdle;
+  Phase after_takeoff_ = Phase::kHold;  // the phase a finished climb enters
   double d_int_m_;
   double cruise_z_m_ = 0;  // world z held by the altitude loop
   double move_end_s_ = 0;  // sim time a move ends

@@ -298,3 +298,77 @@ TEST(MissionFsm, ConstructorValidates) {
   EXPECT_THROW(MissionFsm(0, bad, SceneConfig{}), FieldError);
   EXPECT_THROW(MissionFsm(-1, AgentConfig{}, SceneConfig{}), std::invalid_argument);
 }
+
+TEST(MissionFsm, ARejoiningAgentLandedByFailsafeClimbsThenResumesTheTask) {
+  // The swarm took off at t=1 s and started the task at t=5 s; this agent
+  // restarts at t=40 s, its drone on the ground (the server's failsafe landed it).
+  Flight f;
+  f.o.sim_time_s = 40.0;
+  MissionCommand takeoff = cmd(MissionType::kTakeoff);
+  takeoff.seq = 1;
+  takeoff.issuer = "gs";
+  MissionCommand task = cmd(MissionType::kTask);
+  task.seq = 2;
+  task.issuer = "gs";
+  task.value = 0.8;
+  EXPECT_TRUE(f.fsm.resume(takeoff, 1.0, f.o).accepted);
+  MissionAck a = f.fsm.resume(task, 5.0, f.o);
+  EXPECT_TRUE(a.accepted) << a.reason;
+  EXPECT_EQ(a.phase, Phase::kTakeoff) << "climbs first";
+  f.tick();
+  EXPECT_TRUE(f.out.busy) << "the lockstep clock must run while it climbs";
+  EXPECT_TRUE(f.run_until([&] { return f.fsm.phase() == Phase::kTask; }, 10));
+  EXPECT_NEAR(f.o.p_world.z(), 2.0, f.cfg.altitude_tolerance_m);
+  f.tick();
+  EXPECT_GT(f.out.mission_velocity.norm(), 0.7) << "flies the task again";
+  // The ground station's repeat of the task is recognised, not re-applied.
+  EXPECT_TRUE(f.fsm.apply(task, f.o).accepted);
+  EXPECT_EQ(f.fsm.phase(), Phase::kTask);
+}
+
+TEST(MissionFsm, ARejoiningAgentStillHoveringResumesAtOnceAndAnEndedMoveIsAHold) {
+  Flight f;
+  f.o.p_world = {0, 0, 2.0};
+  f.o.on_ground = false;
+  f.o.sim_time_s = 30.0;
+  MissionCommand takeoff = cmd(MissionType::kTakeoff);
+  takeoff.seq = 1;
+  takeoff.issuer = "gs";
+  MissionCommand mv = move({1, 0, 0}, 5.0);
+  mv.seq = 2;
+  mv.issuer = "gs";
+  ASSERT_TRUE(f.fsm.resume(takeoff, 1.0, f.o).accepted);
+  ASSERT_TRUE(f.fsm.resume(mv, 10.0, f.o).accepted);  // ended at t=15 s
+  f.tick();
+  f.tick();
+  EXPECT_EQ(f.out.phase, Phase::kHold);
+  EXPECT_EQ(f.out.mission_velocity, Vector3d::Zero());
+
+  Flight g;
+  g.o = f.o;
+  ASSERT_TRUE(g.fsm.resume(takeoff, 1.0, g.o).accepted);
+  ASSERT_TRUE(g.fsm.resume(mv, 28.0, g.o).accepted);  // 3 s of it left
+  g.tick();
+  g.tick();
+  EXPECT_EQ(g.out.phase, Phase::kMove);
+  EXPECT_TRUE(g.run_until([&] { return g.out.phase == Phase::kHold; }, 10));
+  EXPECT_NEAR(g.stepped_at_s, 33.0, 0.06) << "the move ends when the swarm's ends";
+}
+
+TEST(MissionFsm, ResumeAfterALandStaysDownAndRejectsFlyingCommands) {
+  Flight f;
+  f.o.sim_time_s = 50.0;
+  MissionCommand takeoff = cmd(MissionType::kTakeoff);
+  takeoff.seq = 1;
+  takeoff.issuer = "gs";
+  MissionCommand land = cmd(MissionType::kLand);
+  land.seq = 2;
+  land.issuer = "gs";
+  ASSERT_TRUE(f.fsm.resume(takeoff, 1.0, f.o).accepted);
+  ASSERT_TRUE(f.fsm.resume(land, 20.0, f.o).accepted);
+  EXPECT_EQ(f.fsm.phase(), Phase::kIdle);
+  MissionCommand task = cmd(MissionType::kTask);
+  task.seq = 3;
+  task.issuer = "gs";
+  EXPECT_EQ(f.fsm.resume(task, 30.0, f.o).reason, "not airborne");
+}

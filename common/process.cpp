@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <exception>
 #include <mutex>
+#include <random>
+#include <unistd.h>
 
 #include "common/config_error.hpp"
 
@@ -68,6 +70,12 @@ double wall_seconds() {
   using namespace std::chrono;
   static const auto t0 = steady_clock::now();
   return duration<double>(steady_clock::now() - t0).count();
+}
+
+std::uint64_t random_instance() {
+  std::random_device rd;
+  std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32 | rd()) ^ static_cast<std::uint64_t>(getpid());
+  return v ? v : 1;
 }
 
 }  // namespace ddswarm

@@ -2,6 +2,7 @@
 // Process lifecycle shared by every executable: stop on SIGINT/SIGTERM,
 // turn exceptions into one line and an exit code.
 #include <chrono>
+#include <cstdint>
 #include <functional>
 
 namespace ddswarm {
@@ -20,5 +21,9 @@ int run_main(const char* prog, const std::function<int()>& body);
 
 /// Wall-clock seconds since an arbitrary fixed start (monotonic).
 double wall_seconds();
+
+/// A random non-zero 64-bit id for this process instance (agents, servers and
+/// ground stations tell a restarted peer from the one they knew by it).
+std::uint64_t random_instance();
 
 }  // namespace ddswarm

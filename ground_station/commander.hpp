@@ -7,8 +7,11 @@
 // as one line a user can act on. World frame ENU (x east, y north, z up),
 // metres, seconds.
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace ddswarm::gs {
 
@@ -30,6 +33,12 @@ struct SwarmStatus {
   std::string mode;             ///< e.g. "lockstep", "realtime"
   std::string task_phase;       ///< e.g. "idle", "hold", "task", "swarm"
   double d_int_m = 0;           ///< m, current wanted inter-drone distance D_int
+  /// Hostile or broken samples rejected (never applied) since start, by reason:
+  /// the server's SimStatus rejected_* counters, then "agents" (the sum of every
+  /// agent's AgentStatus.rejected_samples). Empty when nothing was heard.
+  std::vector<std::pair<std::string, std::uint64_t>> rejected;
+  int failsafe = 0;             ///< drones in failsafe (agent lost: hovering or landing)
+  std::string task;             ///< the refereed task, e.g. "running 12.0 s, 2/6 past finish"; "" = none
 };
 
 /// The commands of the thesis console (Fig. 9), plus hold and teleop.

@@ -18,13 +18,15 @@
 namespace ddswarm::gs {
 
 std::string TaskOutcome::line() const {
-  if (!ok) return "task failed: " + reason;
+  std::string lost;
+  if (!lost_drones.empty()) lost = fmt::format("; lost drones (agent lost, failsafe): {}", fmt::join(lost_drones, ", "));
+  if (!ok) return "task failed: " + reason + lost;
   return fmt::format(
       "task complete: {:.2f} s sim time (wall {:.1f} s), {} drones at {:.2f} m/s, collisions: "
       "obstacle {}, drone {}, ground {}; min inter-drone distance {:.2f} m, min obstacle "
       "clearance {:.2f} m",
       task_time_s, wall_time_s, drones, speed_mps, collisions_obstacle, collisions_drone,
-      collisions_ground, min_inter_drone_m, min_clearance_m);
+      collisions_ground, min_inter_drone_m, min_clearance_m) + lost;
 }
 
 namespace {
@@ -32,6 +34,7 @@ struct AgentSeen {
   double wall = -1e9;
   double d_int = 0;
   Phase phase = Phase::kIdle;
+  std::uint64_t rejected = 0;  // AgentStatus.rejected_samples
 };
 }  // namespace
 
@@ -61,10 +64,7 @@ struct DdsCommander::Impl {
 
   Impl(const GroundStationConfig& c, const DdsConfig& d)
       : cfg(c),
-        instance([] {
-          std::random_device rd;
-          return (static_cast<std::uint64_t>(rd()) << 32 | rd()) ^ static_cast<std::uint64_t>(getpid());
-        }()),
+        instance(random_instance()),
         dds(d, "ddswarm-gs"),
         w_mission(dds.writer<msg::MissionCommand>()) {
     // Seqs increase across ground-station sessions too, so agents never
@@ -92,6 +92,7 @@ struct DdsCommander::Impl {
       s.wall = wall_seconds();
       s.d_int = a.inter_distance_m();
       s.phase = static_cast<Phase>(a.phase());
+      s.rejected = a.rejected_samples();
       cv.notify_all();
     });
     ack_reader = &dds.reader<msg::MissionAck>([this](const msg::MissionAck& a, const fdds::SampleInfo&) {
@@ -148,6 +149,9 @@ struct DdsCommander::Impl {
     }
     msg::MissionCommand m = to_msg(c);
     m.issuer_instance(instance);
+    // Addressed to the server we hear: a restarted server ignores it (our
+    // transient-local history must not replay an old mission in a new world).
+    if (sim) m.server_instance(sim->server_instance());
     last_command_wall = wall_seconds();
     lock.unlock();
     if (!w_mission.write(m)) return {false, "DDS refused the command"};
@@ -314,18 +318,30 @@ CommandResult DdsCommander::task(double speed, double eps) {
   return impl_->send(c);
 }
 
+bool DdsCommander::attach_task(double timeout_s) {
+  auto& I = *impl_;
+  bool ok = I.wait(timeout_s, [&] { return I.task && I.task->phase() != msg::TASK_NONE; });
+  std::lock_guard<std::mutex> lock(I.mu);
+  if (!ok || !I.task) return false;
+  I.task_seq = I.task->seq();
+  return true;
+}
+
 std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_progress) {
   auto& I = *impl_;
   std::unique_lock<std::mutex> lock(I.mu);
   const double start = wall_seconds();
   double last_progress = start;
   TaskOutcome o;
+  const std::uint64_t server_instance = I.sim ? I.sim->server_instance() : 0;
+  bool server_lost = false;
   while (true) {
     I.cv.wait_for(lock, std::chrono::milliseconds(200));
     double now = wall_seconds();
     const bool mine = I.task && I.task->seq() == I.task_seq;
     if (mine && (I.task->phase() == msg::TASK_COMPLETE || I.task->phase() == msg::TASK_FAILED)) {
       const auto& t = *I.task;
+      for (auto id : t.lost_drones()) o.lost_drones.push_back(id);
       o.ok = t.phase() == msg::TASK_COMPLETE;
       o.reason = t.reason().to_string();
       o.task_time_s = t.elapsed_s();
@@ -350,9 +366,29 @@ std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_p
       o.reason = fmt::format("no result within {:.0f} s of wall time", I.cfg.task_timeout_s);
       break;
     }
-    if (now - I.sim_wall > 3.0) {
-      o.reason = "server lost (no status for 3 s)";
+    // The server: silent for a second is reported; a new instance (a
+    // restart: a new world) ends the task; silent past server_timeout_s gives up.
+    const double silent = now - I.sim_wall;
+    if (silent > 1.0 && !server_lost) {
+      server_lost = true;
+      lock.unlock();
+      if (on_progress) on_progress(fmt::format("server lost: no status for {:.1f} s; waiting up to {:.0f} s for it", silent, I.cfg.server_timeout_s));
+      lock.lock();
+    }
+    if (silent > I.cfg.server_timeout_s) {
+      o.reason = fmt::format("server lost (no status for {:.0f} s)", I.cfg.server_timeout_s);
       break;
+    }
+    if (I.sim && I.sim->server_instance() != server_instance) {
+      o.reason = fmt::format("server restarted (instance {:016x}, was {:016x}): the task ended with the old world",
+                             I.sim->server_instance(), server_instance);
+      break;
+    }
+    if (server_lost && silent <= 1.0) {
+      server_lost = false;
+      lock.unlock();
+      if (on_progress) on_progress("server back");
+      lock.lock();
     }
     if (on_progress && now - last_progress >= 2.0 && mine) {
       last_progress = now;
@@ -384,6 +420,30 @@ SwarmStatus DdsCommander::status() {
   } else {
     s.real_time_factor = std::nan("");
     s.mode = "no server";
+  }
+  if (impl_->sim) s.failsafe = impl_->sim->failsafe();
+  if (impl_->task) {
+    const auto& t = *impl_->task;
+    if (t.phase() == msg::TASK_RUNNING)
+      s.task = fmt::format("running {:.1f} s, {}/{} past finish", t.elapsed_s(), t.past_finish(), t.drones());
+    else if (t.phase() == msg::TASK_COMPLETE)
+      s.task = fmt::format("complete in {:.2f} s", t.elapsed_s());
+    else if (t.phase() == msg::TASK_FAILED)
+      s.task = "failed: " + t.reason().to_string();
+    if (t.phase() != msg::TASK_NONE && !t.lost_drones().empty())
+      s.task += fmt::format(", lost drones {}", fmt::join(t.lost_drones(), " "));
+  }
+  if (impl_->sim) {
+    const auto& m = *impl_->sim;
+    s.rejected = {{"non-finite", m.rejected_non_finite()}, {"absurd", m.rejected_absurd()},
+                  {"unknown id", m.rejected_unknown_id()}, {"stale tick", m.rejected_stale_tick()},
+                  {"future tick", m.rejected_future_tick()}, {"impostor", m.rejected_impostor()},
+                  {"mission", m.rejected_mission()}};
+  }
+  if (!impl_->agents.empty()) {
+    std::uint64_t by_agents = 0;
+    for (const auto& [id, a] : impl_->agents) by_agents += a.rejected;
+    s.rejected.emplace_back("agents", by_agents);
   }
   std::map<Phase, int> phases;
   for (const auto& [id, a] : impl_->agents) phases[a.phase]++;

@@ -4,6 +4,7 @@
 #include <memory>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "common/dds_config.hpp"
 #include "ground_station/commander.hpp"
@@ -25,6 +26,7 @@ struct TaskOutcome {
   double min_clearance_m = 0;
   std::uint64_t seed = 0;     ///< the scenario's seed (from the server's Scene)
   std::string scenario;       ///< the scenario's name
+  std::vector<int> lost_drones;  ///< drones whose agent was lost during the task
   std::string line() const;  ///< the one-line result
 };
 
@@ -60,6 +62,10 @@ class DdsCommander final : public Commander {
   CommandResult hold_for(double duration_s);
   CommandResult task(double speed_mps, double epsilon_m) override;
   std::string wait_task(std::function<void(const std::string&)> on_progress) override;
+  /// Follows the task the server referees now (or last refereed) as if this
+  /// ground station had started it, so wait_task() reports it: a new ground
+  /// station after the first one died. False when no task is heard in timeout_s.
+  bool attach_task(double timeout_s);
   SwarmStatus status() override;
 
   /// The last task's outcome, once wait_task() returned.

@@ -8,6 +8,7 @@ void load(YamlSection s, GroundStationConfig& c) {
   s.get("online_window_s", c.online_window_s);
   s.get("discovery_timeout_s", c.discovery_timeout_s);
   s.get("task_timeout_s", c.task_timeout_s);
+  s.get("server_timeout_s", c.server_timeout_s);
   s.get("max_input_speed_mps", c.max_input_speed_mps);
   s.get("max_input_time_s", c.max_input_time_s);
   s.get("results_csv", c.results_csv);
@@ -19,6 +20,7 @@ void GroundStationConfig::validate() const {
   check_range("ground_station.online_window_s", online_window_s, 0.3, 60.0);
   check_range("ground_station.discovery_timeout_s", discovery_timeout_s, 0.1, 600.0);
   check_positive("ground_station.task_timeout_s", task_timeout_s);
+  check_positive("ground_station.server_timeout_s", server_timeout_s);
   check_positive("ground_station.max_input_speed_mps", max_input_speed_mps);
   check_positive("ground_station.max_input_time_s", max_input_time_s);
 }

@@ -12,6 +12,7 @@ struct GroundStationConfig {
   double online_window_s = 1.5;     ///< s wall: an agent heard within this is online
   double discovery_timeout_s = 5.0; ///< s wall: how long to wait for the server at start
   double task_timeout_s = 900.0;    ///< s wall: give up waiting for a task
+  double server_timeout_s = 30.0;   ///< s wall: give up on a task whose server stays silent this long
   double max_input_speed_mps = 10;  ///< m/s, the console refuses faster moves
   double max_input_time_s = 3600;   ///< s, the console refuses longer moves
   std::string results_csv;          ///< append each task's result here ("" = don't)

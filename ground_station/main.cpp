@@ -7,6 +7,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "common/cli_checks.hpp"
 #include "common/process.hpp"
 #include "ground_station/dds_commander.hpp"
 #include "ground_station/experiment.hpp"
@@ -67,45 +68,47 @@ int main(int argc, char** argv) {
     int wait_count = -1;
     double wait_timeout = 30;
     wait_agents->add_option("--count", wait_count, "agents to wait for (default: all drones)");
-    wait_agents->add_option("--timeout", wait_timeout, "seconds");
+    wait_agents->add_option("--timeout", wait_timeout, "seconds")->check(finite_range(0.0, 86400.0));
     auto* takeoff = app.add_subcommand("takeoff", "take off and hold");
     double altitude = 0;
     bool wait_flag = false;
-    takeoff->add_option("--altitude", altitude, "m above ground (0 = agents' default)")->check(CLI::Range(0.0, 1000.0));
+    takeoff->add_option("--altitude", altitude, "m above ground (0 = agents' default)")->check(finite_range(0.0, 1000.0));
     takeoff->add_flag("--wait", wait_flag, "wait until every drone has reached its altitude");
     auto* move = app.add_subcommand("move", "move the swarm by velocity for a time");
     double north = 0, east = 0, up = 0, time_s = 0;
-    move->add_option("--north", north, "m/s")->check(CLI::Range(-50.0, 50.0));
-    move->add_option("--east", east, "m/s")->check(CLI::Range(-50.0, 50.0));
-    move->add_option("--up", up, "m/s")->check(CLI::Range(-50.0, 50.0));
-    move->add_option("--time", time_s, "s")->required()->check(CLI::Range(0.0, 86400.0));
+    move->add_option("--north", north, "m/s")->check(finite_range(-50.0, 50.0));
+    move->add_option("--east", east, "m/s")->check(finite_range(-50.0, 50.0));
+    move->add_option("--up", up, "m/s")->check(finite_range(-50.0, 50.0));
+    move->add_option("--time", time_s, "s")->required()->check(finite_range(0.0, 86400.0));
     move->add_flag("--wait", wait_flag, "wait until the move's time has passed (sim time)");
     auto* distance = app.add_subcommand("distance", "change the inter-drone distance D_int");
     double d_int = 0;
-    distance->add_option("metres", d_int, "new D_int (m)")->required()->check(CLI::Range(0.31, 1000.0));
+    distance->add_option("metres", d_int, "new D_int (m)")->required()->check(finite_range(0.31, 1000.0));
     auto* land = app.add_subcommand("land", "land every drone");
     land->add_flag("--wait", wait_flag, "wait until every drone is on the ground");
     auto* hold = app.add_subcommand("hold", "stop mission motion, keep swarming");
     double hold_s = 0;
     hold->add_option("--time", hold_s, "swarm in place for this many sim seconds (lockstep runs the clock meanwhile)")
-        ->check(CLI::Range(0.0, 86400.0));
+        ->check(finite_range(0.0, 86400.0));
     hold->add_flag("--wait", wait_flag, "wait until the time has passed (sim time)");
     auto* follow = app.add_subcommand("follow", "follow the leader: the rest swarm around it");
     int leader = 0;
     follow->add_option("--leader", leader, "leader drone id")->required()->check(CLI::Range(0, 1023));
     auto* teleop = app.add_subcommand("teleop", "set the leader's velocity while following");
-    teleop->add_option("--north", north, "m/s")->check(CLI::Range(-50.0, 50.0));
-    teleop->add_option("--east", east, "m/s")->check(CLI::Range(-50.0, 50.0));
-    teleop->add_option("--up", up, "m/s")->check(CLI::Range(-50.0, 50.0));
+    teleop->add_option("--north", north, "m/s")->check(finite_range(-50.0, 50.0));
+    teleop->add_option("--east", east, "m/s")->check(finite_range(-50.0, 50.0));
+    teleop->add_option("--up", up, "m/s")->check(finite_range(-50.0, 50.0));
     auto* task = app.add_subcommand("task", "run the thesis task (the swarm must be airborne)");
     double speed = 0, epsilon = 0;
     bool no_wait = false, fly = false;
     std::string csv;
-    task->add_option("--speed", speed, "m/s toward the goal (default: task.speed_mps)")->check(CLI::Range(0.0, 50.0));
-    task->add_option("--epsilon", epsilon, "m, swarm condition (default: 2*D_int+1)")->check(CLI::Range(0.0, 10000.0));
+    task->add_option("--speed", speed, "m/s toward the goal (default: task.speed_mps)")->check(finite_range(0.0, 50.0));
+    task->add_option("--epsilon", epsilon, "m, swarm condition (default: 2*D_int+1)")->check(finite_range(0.0, 10000.0));
     task->add_flag("--no-wait", no_wait, "return once accepted");
     task->add_flag("--takeoff", fly, "wait for every agent, take off first, then run the task");
     task->add_option("--csv", csv, "append the result to this CSV");
+    bool attach = false;
+    task->add_flag("--attach", attach, "send nothing: report the task the server is refereeing (e.g. after a ground station died)");
     auto* status = app.add_subcommand("status", "print the swarm's status");
     bool status_drones = false;
     status->add_flag("--drones", status_drones, "also print every drone and the pairwise distances");
@@ -115,7 +118,8 @@ int main(int argc, char** argv) {
     double trace_duration = 0;
     trace->add_option("--out", trace_out, "CSV file")->required();
     trace->add_option("--every", trace_every, "keep one tick in N")->check(CLI::Range(1, 100000));
-    trace->add_option("--duration", trace_duration, "wall seconds (0 = until Ctrl-C)");
+    trace->add_option("--duration", trace_duration, "wall seconds (0 = until Ctrl-C)")
+        ->check(finite_range(0.0, 1e9));
     auto* experiment = app.add_subcommand("experiment", "run an experiment file (e.g. config/table1.yaml)");
     std::string exp_file, out_dir = "results";
     experiment->add_option("file", exp_file, "experiment YAML")->required();
@@ -131,6 +135,7 @@ int main(int argc, char** argv) {
     spdlog::set_level(spdlog::level::warn);
     auto file = load_gs_config(config);
     merge_cli(file.dds, dds_cli, app);
+    default_security_role(file.dds, "gs");
     file.dds.validate();
     install_stop_signals();
 
@@ -154,7 +159,7 @@ int main(int argc, char** argv) {
     const bool interactive = app.get_subcommands().empty() || *menu;
     // Give discovery a moment: the server's status is transient-local.
     // Status needs only the clock (a replayed recording has no server to command).
-    const bool ready = *status ? gs.wait_for_status(file.gs.discovery_timeout_s)
+    const bool ready = (*status || (*task && attach)) ? gs.wait_for_status(file.gs.discovery_timeout_s)
                                : gs.wait_for_server(file.gs.discovery_timeout_s);
     if (!ready && !interactive) {
       std::fprintf(stderr, "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",
@@ -178,7 +183,8 @@ int main(int argc, char** argv) {
       return ok ? 0 : 1;
     }
     if (*status) {
-      std::printf("%s\n", format_status(gs.status()).c_str());
+      const SwarmStatus st = gs.status();
+      std::printf("%s\n%s\n", format_status(st).c_str(), format_rejections(st).c_str());
       if (status_drones) {
         auto snap = snapshot(file.dds, 3.0);
         if (!snap) {
@@ -224,7 +230,17 @@ int main(int argc, char** argv) {
       if (epsilon > 0) t.epsilon_m = epsilon;
       auto progress = [](const std::string& p) { std::printf("  %s\n", p.c_str()); std::fflush(stdout); };
       TaskOutcome o;
-      if (fly) {
+      if (attach) {
+        if (!gs.attach_task(file.gs.discovery_timeout_s)) {
+          std::fprintf(stderr, "ddswarm-gs: error: the server reports no task within %.0f s\n",
+                       file.gs.discovery_timeout_s);
+          return 1;
+        }
+        auto st = gs.status();
+        std::printf("attached: task %s\n", st.task.c_str());
+        gs.wait_task(progress);
+        o = gs.last_task().value_or(TaskOutcome{});
+      } else if (fly) {
         o = fly_task(gs, file.drones, t, progress);
       } else {
         auto r = gs.task(t.speed_mps, t.epsilon_m);

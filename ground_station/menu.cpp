@@ -432,12 +432,25 @@ std::string format_status(const SwarmStatus& s) {
     os << "x? real time | ";
   os << "drones " << s.drones_online << '/' << s.drones_total << " online | " << s.airborne
      << " airborne | " << s.collisions << " collisions";
+  if (s.failsafe > 0) os << " | " << s.failsafe << " in failsafe";
   os.unsetf(std::ios::floatfield);
   os << std::setprecision(6);
   if (!s.mode.empty()) os << " | " << s.mode;
   if (!s.task_phase.empty()) os << " | phase " << s.task_phase;
+  if (!s.task.empty()) os << " | task " << s.task;
   os << " | D_int " << s.d_int_m << " m]";
   return os.str();
+}
+
+std::string format_rejections(const SwarmStatus& s) {
+  if (s.rejected.empty()) return "rejected samples: unknown (no server or agent heard)";
+  std::uint64_t total = 0;
+  std::string parts;
+  for (const auto& [reason, n] : s.rejected) {
+    total += n;
+    parts += (parts.empty() ? "" : ", ") + reason + " " + std::to_string(n);
+  }
+  return "rejected samples: " + std::to_string(total) + " (" + parts + ")";
 }
 
 int run_menu(Commander& commander, LineReader& reader, std::ostream& out,

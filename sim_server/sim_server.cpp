@@ -17,6 +17,7 @@
 #include "common/participant.hpp"
 #include "common/process.hpp"
 #include "sim_server/command_gate.hpp"
+#include "sim_server/mission_ring.hpp"
 #include "sim_server/task_referee.hpp"
 
 namespace ddswarm::sim {
@@ -28,6 +29,12 @@ void ServerConfig::validate() const {
   controller.validate();
   sensors.validate();
   scene.validate();
+  // Nothing lies beyond the world's bounds: a longer ray is a typo (cm for m?).
+  const double world_m = (scene.bounds_max - scene.bounds_min).norm();
+  if (sensors.max_range_m > world_m)
+    throw FieldError("sensors.max_range_m", to_text(sensors.max_range_m),
+                     "must be <= the world's size (diagonal of scene.bounds_min..bounds_max, " +
+                         to_text(world_m) + " m)");
   dds.validate();
   (void)scene.start_positions(scenario.drones, scenario.seed);
 }
@@ -102,6 +109,9 @@ struct SimServer::Impl {
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   double agent_d_int = 0;
+  // Random per process: Scene and SimStatus carry it, so agents and ground
+  // stations tell a restarted server (a new world) from the one they knew.
+  const std::uint64_t instance = random_instance();
   msg::SimStatus counters;  // rejected_* and commands_* live here
 
   // Main thread only.
@@ -173,10 +183,25 @@ struct SimServer::Impl {
             static_cast<float>(cfg.sensors.yaw_offset_rad + 2.0 * M_PI * k / cfg.sensors.count));
     }
     counters.num_drones(static_cast<std::uint16_t>(n));
+    counters.server_instance(instance);
     counters.mode(cfg.scenario.mode == TimeMode::kLockstep ? msg::MODE_LOCKSTEP : msg::MODE_REALTIME);
 
-    dds.reader<msg::VelocityCommand>(
-        [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); });
+    if (!dds.secure()) {
+      dds.reader<msg::VelocityCommand>(
+          [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); });
+    } else {
+      // DDS Security: only agent-K may publish in partition drone/K, so one
+      // reader per drone knows whose commands it hears; a command there for
+      // another drone is an impostor's (docs/security.md).
+      for (int k = 0; k < n; ++k)
+        dds.reader<msg::VelocityCommand>(
+            [this, k](const msg::VelocityCommand& c, const fdds::SampleInfo&) {
+              if (c.drone_id() == k) return on_command(c);
+              std::lock_guard<std::mutex> lock(mu);
+              counters.rejected_impostor(counters.rejected_impostor() + 1);
+            },
+            drone_partition(k));
+    }
     dds.reader<msg::AgentStatus>(
         [this](const msg::AgentStatus& s, const fdds::SampleInfo&) { on_heartbeat(s); });
     dds.reader<msg::MissionCommand>(
@@ -263,6 +288,15 @@ struct SimServer::Impl {
       spdlog::warn("mission command seq {} rejected: {}", m.seq(), problem);
       return;
     }
+    // Addressed to a server that is gone (e.g. a ground station's
+    // transient-local history meeting a restarted server): the mission it
+    // belonged to ended with that world.
+    if (m.server_instance() != 0 && m.server_instance() != instance) {
+      counters.rejected_stale_mission(counters.rejected_stale_mission() + 1);
+      spdlog::warn("mission command seq {} from {} was for server {:016x}, not this one: ignored",
+                   m.seq(), m.issuer().to_string(), m.server_instance());
+      return;
+    }
     // A repeat (the ground station lost an ack, or re-sent its history to a
     // restarted server) is forwarded again: agents re-acknowledge it and do not re-apply it.
     if (!seen_missions.insert({m.issuer_instance(), m.seq()}).second)
@@ -296,7 +330,7 @@ struct SimServer::Impl {
       return r.issuer_instance() == m.issuer_instance() && r.seq() == m.seq();
     });
     recent.push_back(m);
-    while (recent.size() > 8) recent.pop_front();
+    trim_recent(recent, 8);
   }
 
   /// Releases at most one new pending mission command onto this tick; repeats
@@ -406,6 +440,7 @@ struct SimServer::Impl {
     msg::Scene s;
     s.name(cfg.scenario.name.substr(0, 127));
     s.seed(cfg.scenario.seed);
+    s.server_instance(instance);
     s.num_drones(static_cast<std::uint16_t>(n));
     s.mode(cfg.scenario.mode == TimeMode::kLockstep ? msg::MODE_LOCKSTEP : msg::MODE_REALTIME);
     s.physics_rate_hz(cfg.sim.physics_rate_hz);
@@ -502,7 +537,10 @@ struct SimServer::Impl {
         sc.hit().assign(hits.begin(), hits.end());
       }
       // A drone in failsafe (its agent lost) no longer counts for the task.
-      if (failsafe_since[i] < 0) positions.push_back(st.p_world);
+      if (failsafe_since[i] < 0)
+        positions.push_back(st.p_world);
+      else
+        referee.note_lost(i);
     }
     for (auto& b : swarm_msg.beacons()) b.true_position(swarm_msg.drones()[b.drone_id()].position());
     bool task_changed = referee.update(t, positions, cfg.sim.task_timeout_s);
@@ -544,6 +582,7 @@ struct SimServer::Impl {
     m.collisions_obstacle(r.collisions_obstacle);
     m.collisions_drone(r.collisions_drone);
     m.collisions_ground(r.collisions_ground);
+    for (int id : r.lost_drones) m.lost_drones().push_back(static_cast<std::uint16_t>(id));
     w_task.write(m);
     if (changed && r.phase == TaskPhase::kComplete)
       spdlog::info("task complete: {:.2f} s sim, {} obstacle / {} drone / {} ground collisions, "

@@ -23,6 +23,12 @@ void TaskReferee::fail(const std::string& reason) {
   r_.reason = reason;
 }
 
+void TaskReferee::note_lost(int id) {
+  if (r_.phase != TaskPhase::kRunning) return;
+  auto it = std::lower_bound(r_.lost_drones.begin(), r_.lost_drones.end(), id);
+  if (it == r_.lost_drones.end() || *it != id) r_.lost_drones.insert(it, id);
+}
+
 void TaskReferee::count_collision(int kind) {
   if (r_.phase != TaskPhase::kRunning) return;
   if (kind == 0) ++r_.collisions_obstacle;

@@ -31,6 +31,7 @@ struct TaskReport {
   double min_inter_drone_m = 0;
   double min_clearance_m = 0;
   std::uint32_t collisions_obstacle = 0, collisions_drone = 0, collisions_ground = 0;
+  std::vector<int> lost_drones;  ///< drones whose agent was lost while the task ran, ascending
 };
 
 class TaskReferee {
@@ -45,6 +46,8 @@ class TaskReferee {
   bool update(double sim_time_s, const std::vector<Eigen::Vector3d>& positions, double timeout_s);
   /// Counts a collision that began during the task.
   void count_collision(int kind);  // 0 obstacle, 1 drone, 2 ground
+  /// Records that drone id's agent was lost (failsafe) while the task runs.
+  void note_lost(int id);
 
   bool running() const { return r_.phase == TaskPhase::kRunning; }
   const TaskReport& report() const { return r_; }

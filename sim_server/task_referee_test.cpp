@@ -60,3 +60,19 @@ TEST(TaskReferee, FailsOnTimeoutOrAbort) {
   EXPECT_EQ(r.report().phase, TaskPhase::kFailed);
   EXPECT_FALSE(r.running());
 }
+
+TEST(TaskReferee, ReportsDronesLostDuringTheTaskOnceAndOnlyWhileRunning) {
+  SceneConfig s = course();
+  TaskReferee r(s);
+  r.note_lost(4);  // before the task: not this task's loss
+  r.start(1, 0.0, 5.0, 0.8, 6);
+  r.note_lost(3);
+  r.note_lost(1);
+  r.note_lost(3);
+  EXPECT_EQ(r.report().lost_drones, (std::vector<int>{1, 3}));
+  r.fail("aborted");
+  r.note_lost(5);
+  EXPECT_EQ(r.report().lost_drones, (std::vector<int>{1, 3}));
+  r.start(2, 1.0, 5.0, 0.8, 6);
+  EXPECT_TRUE(r.report().lost_drones.empty());
+}
