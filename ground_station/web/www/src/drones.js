@@ -1,0 +1,392 @@
+// The drones: a quadrotor model (body, four arms with motor pods, four
+// two-blade rotors with a blur disc) drawn with one InstancedMesh per part,
+// so 128+ drones cost a handful of draw calls. Attitude comes from the
+// state's quaternion (body FLU -> world ENU); rotors turn at their measured
+// rad/s, slowed down for the eye. Also: trails (one LineSegments, a ring of
+// time slots shared by every drone), sensor rays, collision flashes and a
+// ring under drones in failsafe or whose agent is lost.
+import * as THREE from 'three';
+import { mergeGeometries } from 'three/addons/utils/BufferGeometryUtils.js';
+import { FLAG } from './protocol.js';
+import { surface } from './world.js';
+
+// Rotor layout (sim_server/quadrotor.hpp): 0 front-right CCW, 1 rear-left CCW,
+// 2 front-left CW, 3 rear-right CW; arms at -45, 135, 45, -135 degrees.
+const ROTOR_ANGLE = [-45, 135, 45, -135].map((d) => (d * Math.PI) / 180);
+const ROTOR_SPIN = [1, 1, -1, -1];   // +1: counter-clockwise seen from above
+export const SPIN_SCALE = 0.045;     // drawn rad/s per real rad/s (500 rad/s -> ~3.6 turns/s)
+
+const TRAIL_SLOTS = 480;             // per drone
+const TRAIL_DT = 0.25;               // s of sim time between trail points
+const TRAIL_LIFE = 120;              // s of sim time a trail point stays visible
+const FLASH_MS = 900;
+
+const COL_FAILSAFE = new THREE.Color(0xf3a531);
+const COL_LOST = new THREE.Color(0x7a828c);
+const COL_FLASH = new THREE.Color(0xff2222);
+const COL_WHITE = new THREE.Color(0xffffff);
+const COL_SELECT = new THREE.Color(0x4fb3ff);
+
+export function droneColour(id, out = new THREE.Color()) {
+  // Golden-angle hues: neighbouring ids get well separated colours.
+  return out.setHSL(((id * 0.381966) % 1 + 0.58) % 1, 0.78, 0.5);
+}
+
+function quadGeometries(arm) {
+  const g = {};
+  const bodyL = arm * 0.95, bodyW = arm * 0.62, bodyH = arm * 0.3;
+  // Body: a box with a small canopy; coloured per drone.
+  g.body = mergeGeometries([
+    new THREE.BoxGeometry(bodyL, bodyW, bodyH),
+    new THREE.SphereGeometry(bodyW * 0.42, 12, 8, 0, Math.PI * 2, 0, Math.PI / 2).scale(1.3, 1, 0.7).translate(0, 0, bodyH / 2),
+  ]);
+  // Frame: arms, motor pods, legs and a nose light, with vertex colours.
+  const parts = [];
+  const paint = (geo, hex) => {
+    const c = new THREE.Color(hex), n = geo.attributes.position.count, a = new Float32Array(3 * n);
+    for (let i = 0; i < n; i++) c.toArray(a, 3 * i);
+    geo.setAttribute('color', new THREE.BufferAttribute(a, 3));
+    return geo;
+  };
+  for (let k = 0; k < 4; k++) {
+    const a = ROTOR_ANGLE[k], cx = Math.cos(a) * arm, cy = Math.sin(a) * arm;
+    const armGeo = new THREE.BoxGeometry(arm, arm * 0.09, arm * 0.07).translate(arm / 2, 0, 0).rotateZ(a);
+    parts.push(paint(armGeo, k === 0 || k === 2 ? 0x3a3f47 : 0x2a2d33));
+    parts.push(paint(new THREE.CylinderGeometry(arm * 0.09, arm * 0.1, arm * 0.2, 12).rotateX(Math.PI / 2).translate(cx, cy, arm * 0.05), 0x1b1d21));
+    parts.push(paint(new THREE.CylinderGeometry(arm * 0.025, arm * 0.025, arm * 0.35, 6).rotateX(Math.PI / 2).translate(cx * 0.45, cy * 0.45, -arm * 0.2), 0x23262b));
+  }
+  parts.push(paint(new THREE.SphereGeometry(arm * 0.07, 8, 6).translate(bodyL / 2, 0, 0), 0xff4d2e));
+  g.frame = mergeGeometries(parts);
+  // Rotor: two blades; and a translucent disc drawn while the motors turn.
+  const prop = arm * 0.55;
+  g.blade = new THREE.BoxGeometry(2 * prop, arm * 0.08, arm * 0.015);
+  g.disc = new THREE.CircleGeometry(prop * 1.02, 24);
+  g.rotorZ = arm * 0.17;
+  g.ring = new THREE.RingGeometry(arm * 2.0, arm * 2.5, 32);
+  g.blob = new THREE.CircleGeometry(arm * 1.15, 16);
+  return g;
+}
+
+export class Drones {
+  constructor(scene) {
+    this.scene = scene;
+    this.group = new THREE.Group();
+    scene.add(this.group);
+    this.n = 0;
+    this.scale = 2;
+    this.showTrails = true;
+    this.showRays = false;
+    this.blobShadows = false;
+    this.selected = -1;
+    this.tmp = { m: new THREE.Matrix4(), r: new THREE.Matrix4(), q: new THREE.Quaternion(), p: new THREE.Vector3(), s: new THREE.Vector3(), c: new THREE.Color(), v: new THREE.Vector3() };
+  }
+
+  // (Re)creates the meshes for n drones with the scene's arm length and rays.
+  configure(n, arm = 0.2275, sensorCount = 8, groundZ = 0) {
+    this.dispose();
+    this.groundZ = groundZ;
+    this.n = n;
+    this.arm = arm > 0 ? arm : 0.2275;
+    this.sensorCount = Math.max(0, Math.min(64, sensorCount | 0));
+    const g = quadGeometries(this.arm);
+    const mk = (geo, mat, count, shadow = true) => {
+      const m = new THREE.InstancedMesh(geo, mat, count);
+      m.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+      m.frustumCulled = false;
+      m.castShadow = shadow;
+      m.count = 0;
+      this.group.add(m);
+      return m;
+    };
+    this.body = mk(g.body, surface({ color: 0xffffff, roughness: 0.45, metalness: 0.1 }), n);
+    this.body.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
+    this.frame = mk(g.frame, surface({ vertexColors: true, roughness: 0.6, metalness: 0.2 }), n);
+    this.blades = mk(g.blade, surface({ color: 0x15171a, roughness: 0.4 }), 4 * n);
+    this.discs = mk(g.disc, new THREE.MeshBasicMaterial({ color: 0xcfd6de, transparent: true, opacity: 0.22, depthWrite: false, side: THREE.DoubleSide }), 4 * n, false);
+    this.rings = mk(g.ring, new THREE.MeshBasicMaterial({ color: 0xffffff, transparent: true, opacity: 0.9, depthWrite: false, side: THREE.DoubleSide }), n, false);
+    this.rings.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
+    // Blob shadows, for when the world has no shadow maps (quality low).
+    this.blobs = mk(g.blob, new THREE.MeshBasicMaterial({ color: 0x000000, transparent: true, opacity: 0.22, depthWrite: false }), n, false);
+    this.blobs.visible = this.blobShadows;
+    this.rotorZ = g.rotorZ;
+    this.rotorPos = ROTOR_ANGLE.map((a) => new THREE.Vector3(Math.cos(a) * this.arm, Math.sin(a) * this.arm, g.rotorZ));
+
+    this.pos = new Float64Array(3 * n);       // as rendered
+    this.quat = new Float32Array(4 * n);
+    this.w = new Float32Array(4 * n);
+    this.angle = new Float32Array(4 * n).map(() => Math.random() * Math.PI);
+    this.flags = new Uint16Array(n);
+    this.flashUntil = new Float64Array(n);
+    this.colSum = new Float64Array(n).fill(-1);
+    this.present = new Uint8Array(n);
+    this.base = Array.from({ length: n }, (_, i) => droneColour(i));
+    this.count = 0;
+    this.liveKnown = false;
+    this.liveMask = new Uint8Array(n);
+
+    // Trails: slot k of drone i is segment (k * n + i): two vertices.
+    const tv = TRAIL_SLOTS * n * 2;
+    const tg = new THREE.BufferGeometry();
+    tg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * tv), 3).setUsage(THREE.DynamicDrawUsage));
+    tg.setAttribute('tcolor', new THREE.BufferAttribute(new Float32Array(3 * tv), 3).setUsage(THREE.DynamicDrawUsage));
+    tg.setAttribute('stamp', new THREE.BufferAttribute(new Float32Array(tv).fill(-1e9), 1).setUsage(THREE.DynamicDrawUsage));
+    this.trailMat = new THREE.ShaderMaterial({
+      uniforms: { uNow: { value: 0 }, uLife: { value: TRAIL_LIFE } },
+      vertexShader: `attribute vec3 tcolor; attribute float stamp; uniform float uNow, uLife;
+        varying vec3 vC; varying float vA;
+        void main() { vC = tcolor; vA = 1.0 - (uNow - stamp) / uLife;
+          gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0); }`,
+      fragmentShader: `varying vec3 vC; varying float vA;
+        void main() { if (vA <= 0.0) discard; gl_FragColor = vec4(vC, 0.25 + 0.65 * vA); }`,
+      transparent: true, depthWrite: false,
+    });
+    this.trails = new THREE.LineSegments(tg, this.trailMat);
+    this.trails.frustumCulled = false;
+    this.trails.visible = this.showTrails;
+    this.group.add(this.trails);
+    this.trailSlot = 0;
+    this.trailT = -Infinity;
+    this.trailLast = new Float32Array(3 * n);
+    this.trailHasLast = new Uint8Array(n);
+
+    // Rays: per drone sensorCount segments.
+    const rv = Math.max(1, this.sensorCount) * n * 2;
+    const rg = new THREE.BufferGeometry();
+    rg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * rv), 3).setUsage(THREE.DynamicDrawUsage));
+    rg.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * rv), 3).setUsage(THREE.DynamicDrawUsage));
+    this.rays = new THREE.LineSegments(rg, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.8, depthWrite: false }));
+    this.rays.frustumCulled = false;
+    this.rays.visible = this.showRays;
+    this.group.add(this.rays);
+  }
+
+  dispose() {
+    for (const c of [...this.group.children]) {
+      this.group.remove(c);
+      c.geometry?.dispose();
+      c.material?.dispose();
+      c.dispose?.();
+    }
+    this.n = 0;
+    this.count = 0;
+  }
+
+  clearTrails() {
+    if (!this.n) return;
+    this.trails.geometry.attributes.stamp.array.fill(-1e9);
+    this.trails.geometry.attributes.stamp.needsUpdate = true;
+    this.trailHasLast.fill(0);
+    this.trailT = -Infinity;
+  }
+
+  // Applies a `frame` message: positions, attitude, rotor speeds, flags.
+  applyFrame(f, nowMs) {
+    const ds = f.drones ?? [];
+    let count = 0;
+    this.present.fill(0);
+    for (const d of ds) {
+      const i = d?.id;
+      if (!Number.isInteger(i) || i < 0 || i >= this.n || !Array.isArray(d.p)) continue;
+      this.present[i] = 1;
+      count++;
+      this.pos[3 * i] = d.p[0]; this.pos[3 * i + 1] = d.p[1]; this.pos[3 * i + 2] = d.p[2];
+      const q = Array.isArray(d.q) ? d.q : [1, 0, 0, 0];
+      // [w,x,y,z] -> three's (x,y,z,w)
+      this.quat[4 * i] = q[1]; this.quat[4 * i + 1] = q[2]; this.quat[4 * i + 2] = q[3]; this.quat[4 * i + 3] = q[0];
+      for (let k = 0; k < 4; k++) this.w[4 * i + k] = Array.isArray(d.w) ? d.w[k] || 0 : 0;
+      this.flags[i] = d.flags | 0;
+      const col = Array.isArray(d.col) ? d.col[0] + d.col[1] + d.col[2] : 0;
+      if (this.colSum[i] >= 0 && col > this.colSum[i]) this.flash(i, nowMs);
+      this.colSum[i] = col;
+    }
+    this.count = count;
+    const t = f.t;
+    if (Number.isFinite(t)) {
+      if (t < this.trailT - 1e-6) this.clearTrails();   // the clock went back: a seek or a new run
+      if (t - this.trailT >= TRAIL_DT) this.addTrailPoint(t);
+      this.trailMat.uniforms.uNow.value = t;
+    }
+    if (this.showRays && Array.isArray(f.rays)) this.applyRays(f.rays);
+  }
+
+  flash(i, nowMs = performance.now()) {
+    if (i >= 0 && i < this.n) this.flashUntil[i] = nowMs + FLASH_MS;
+  }
+
+  addTrailPoint(t) {
+    const n = this.n, slot = this.trailSlot;
+    const pa = this.trails.geometry.attributes.position, ca = this.trails.geometry.attributes.tcolor, sa = this.trails.geometry.attributes.stamp;
+    const P = pa.array, C = ca.array, S = sa.array;
+    for (let i = 0; i < n; i++) {
+      const v = 2 * (slot * n + i);
+      const x = this.pos[3 * i], y = this.pos[3 * i + 1], z = this.pos[3 * i + 2];
+      if (!this.present[i] || !this.trailHasLast[i]) {
+        S[v] = S[v + 1] = -1e9;
+      } else {
+        P.set([this.trailLast[3 * i], this.trailLast[3 * i + 1], this.trailLast[3 * i + 2], x, y, z], 3 * v);
+        const c = this.base[i];
+        C.set([c.r, c.g, c.b, c.r, c.g, c.b], 3 * v);
+        S[v] = this.trailT; S[v + 1] = t;
+      }
+      if (this.present[i]) {
+        this.trailLast[3 * i] = x; this.trailLast[3 * i + 1] = y; this.trailLast[3 * i + 2] = z;
+        this.trailHasLast[i] = 1;
+      }
+    }
+    // Only the slot just written goes to the GPU.
+    for (const [a, size] of [[pa, 3], [ca, 3], [sa, 1]]) {
+      a.clearUpdateRanges();
+      a.addUpdateRange(2 * slot * n * size, 2 * n * size);
+      a.needsUpdate = true;
+    }
+    this.trailSlot = (slot + 1) % TRAIL_SLOTS;
+    this.trailT = t;
+  }
+
+  applyRays(rays) {
+    const n = this.n, m = this.sensorCount;
+    if (!m) return;
+    const pa = this.rays.geometry.attributes.position, ca = this.rays.geometry.attributes.color;
+    const P = pa.array, C = ca.array;
+    const { q, v } = this.tmp;
+    let seg = 0;
+    for (let i = 0; i < n && i < rays.length; i++) {
+      const r = rays[i];
+      if (!this.present[i] || !r || !Array.isArray(r.a) || !Array.isArray(r.r)) continue;
+      q.set(this.quat[4 * i], this.quat[4 * i + 1], this.quat[4 * i + 2], this.quat[4 * i + 3]);
+      const x = this.pos[3 * i], y = this.pos[3 * i + 1], z = this.pos[3 * i + 2];
+      for (let k = 0; k < Math.min(m, r.a.length); k++) {
+        const len = r.r[k];
+        if (!Number.isFinite(len)) continue;
+        v.set(Math.cos(r.a[k]), Math.sin(r.a[k]), 0).applyQuaternion(q).multiplyScalar(len);
+        P.set([x, y, z, x + v.x, y + v.y, z + v.z], 6 * seg);
+        const hit = r.hit?.[k];
+        if (hit) C.set([1, 0.45, 0.1, 1, 0.25, 0.05], 6 * seg);
+        else C.set([0.25, 0.65, 1, 0.25, 0.65, 1], 6 * seg);
+        seg++;
+      }
+    }
+    this.rays.geometry.setDrawRange(0, 2 * seg);
+    pa.needsUpdate = ca.needsUpdate = true;
+  }
+
+  setRays(on) {
+    this.showRays = on;
+    if (this.rays) this.rays.visible = on;
+  }
+
+  setBlobShadows(on) {
+    this.blobShadows = on;
+    if (this.blobs) this.blobs.visible = on;
+    for (const m of [this.body, this.frame, this.blades]) if (m) m.castShadow = !on;
+  }
+
+  setTrails(on) {
+    this.showTrails = on;
+    if (this.trails) this.trails.visible = on;
+  }
+
+  // Per drawn frame: instance matrices, rotor angles, colours.
+  // The server's list of live agents (status.live) overrides the per-drone
+  // AGENT_LIVE bit, which is only as fresh as the last published tick (a
+  // paused lockstep swarm still shows tick 0's).
+  setLive(ids) {
+    if (!this.n) return;
+    if (!Array.isArray(ids)) { this.liveKnown = false; return; }
+    this.liveMask = new Uint8Array(this.n);
+    for (const i of ids) if (i >= 0 && i < this.n) this.liveMask[i] = 1;
+    this.liveKnown = true;
+  }
+
+  isLost(i) {
+    return this.liveKnown ? !this.liveMask[i] : !(this.flags[i] & FLAG.AGENT_LIVE);
+  }
+
+  update(dt, nowMs) {
+    const n = this.n;
+    if (!n) return;
+    const { m, r, q, p, s, c } = this.tmp;
+    const sc = this.scale;
+    let k4 = 0, b = 0;
+    for (let i = 0; i < n; i++) {
+      if (!this.present[i]) continue;
+      p.set(this.pos[3 * i], this.pos[3 * i + 1], this.pos[3 * i + 2]);
+      q.set(this.quat[4 * i], this.quat[4 * i + 1], this.quat[4 * i + 2], this.quat[4 * i + 3]);
+      if (q.lengthSq() < 1e-12) q.identity(); else q.normalize();
+      m.compose(p, q, s.set(sc, sc, sc));
+      this.body.setMatrixAt(b, m);
+      this.frame.setMatrixAt(b, m);
+      const motors = (this.flags[i] & FLAG.MOTORS_ON) !== 0 || this.w[4 * i] > 1;
+      for (let k = 0; k < 4; k++) {
+        const j = 4 * i + k;
+        this.angle[j] = (this.angle[j] + ROTOR_SPIN[k] * this.w[j] * SPIN_SCALE * dt) % (2 * Math.PI);
+        r.makeRotationZ(this.angle[j]).setPosition(this.rotorPos[k]);
+        this.blades.setMatrixAt(k4, r.premultiply(m));
+        if (motors) r.makeTranslation(this.rotorPos[k].x, this.rotorPos[k].y, this.rotorZ + 0.001);
+        else r.makeScale(0, 0, 0);
+        this.discs.setMatrixAt(k4, r.premultiply(m));
+        k4++;
+      }
+      // Body colour: collision flash over failsafe / lost over the drone's own.
+      const flags = this.flags[i];
+      const mark = flags & FLAG.FAILSAFE ? COL_FAILSAFE : this.isLost(i) ? COL_LOST : null;
+      c.copy(mark ?? this.base[i]);
+      const left = this.flashUntil[i] - nowMs;
+      if (left > 0) {
+        const f = left / FLASH_MS, pulse = 0.5 + 0.5 * Math.cos((1 - f) * Math.PI * 6);
+        c.lerp(COL_FLASH, Math.min(1, 1.2 * f)).lerp(COL_WHITE, 0.35 * pulse * f);
+      }
+      this.body.setColorAt(b, c);
+      // Ring under marked or selected drones.
+      if (mark || i === this.selected || left > 0) {
+        const ringColour = left > 0 ? COL_FLASH : mark ?? COL_SELECT;
+        r.makeTranslation(p.x, p.y, p.z - this.arm * 0.5 * sc);
+        r.scale(s.set(sc, sc, sc));
+        this.rings.setMatrixAt(b, r);
+        this.rings.setColorAt(b, ringColour);
+      } else {
+        this.rings.setMatrixAt(b, r.makeScale(0, 0, 0));
+      }
+      if (this.blobShadows) {
+        const k = sc * Math.max(0.35, 1 - (p.z - this.groundZ) / 25);
+        r.makeTranslation(p.x, p.y, this.groundZ + 0.02);
+        this.blobs.setMatrixAt(b, r.scale(s.set(k, k, k)));
+      }
+      b++;
+    }
+    for (const mesh of [this.body, this.frame, this.rings, this.blobs]) mesh.count = b;
+    for (const mesh of [this.blades, this.discs]) mesh.count = 4 * b;
+    for (const mesh of [this.body, this.frame, this.blades, this.discs, this.rings, this.blobs]) mesh.instanceMatrix.needsUpdate = true;
+    this.body.instanceColor.needsUpdate = true;
+    this.rings.instanceColor.needsUpdate = true;
+  }
+
+  // Centroid and radius of the drones shown.
+  centroid(out = new THREE.Vector3()) {
+    let k = 0;
+    out.set(0, 0, 0);
+    for (let i = 0; i < this.n; i++) {
+      if (!this.present[i]) continue;
+      out.x += this.pos[3 * i]; out.y += this.pos[3 * i + 1]; out.z += this.pos[3 * i + 2];
+      k++;
+    }
+    if (!k) return null;
+    out.multiplyScalar(1 / k);
+    let rad = 0;
+    for (let i = 0; i < this.n; i++) {
+      if (!this.present[i]) continue;
+      rad = Math.max(rad, Math.hypot(this.pos[3 * i] - out.x, this.pos[3 * i + 1] - out.y, this.pos[3 * i + 2] - out.z));
+    }
+    out.radius = rad;
+    return out;
+  }
+
+  // The drones as rendered (for the test hook).
+  snapshot() {
+    const out = [];
+    for (let i = 0; i < this.n; i++) {
+      if (this.present[i]) out.push({ id: i, p: [this.pos[3 * i], this.pos[3 * i + 1], this.pos[3 * i + 2]], flags: this.flags[i] });
+    }
+    return out;
+  }
+}
