@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
                                  std::to_string(cfg.scenario.drones - 1) + "] (scenario.drones = " +
                                  std::to_string(cfg.scenario.drones) + ")");
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
+    ddswarm::default_security_role(cfg.dds, "agent-" + std::to_string(id));
     cfg.validate();
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
     ddswarm::install_stop_signals();

@@ -4,6 +4,7 @@
 #include <arpa/inet.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <ifaddrs.h>
 #include <netinet/in.h>
 
@@ -77,11 +78,40 @@ void DdsConfig::validate() const {
                        "a discovery server on another host needs this host's address on that network "
                        "(--dds-local-ip)");
   }
+  if (secure()) {
+    if (security_role.empty() ||
+        security_role.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+            std::string::npos)
+      throw FieldError("dds.security_role", security_role.empty() ? "(empty)" : security_role,
+                       "must name an identity made by scripts/make-certs, e.g. server, gs, recorder, agent-3");
+    std::string missing;
+    for (const auto& f : security_files()) {
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(f, ec))
+        missing += (missing.empty() ? "" : ", ") + std::filesystem::path(f).filename().string();
+    }
+    if (!missing.empty())
+      throw FieldError("dds.secure", security_dir,
+                       "missing " + missing + " for role " + security_role + " (make them with scripts/make-certs --out " +
+                           security_dir + ")");
+  }
   // Fast DDS silently drops a whitelisted address this host does not have,
   // which would leave the process unreachable without a word.
   if (!interface_ip.empty() && discovery != Discovery::kLocalhost && !is_local_address(interface_ip))
     throw FieldError("dds.interface_ip", interface_ip, "is not an address of this host");
 }
+
+std::vector<std::string> DdsConfig::security_files() const {
+  const std::string d = security_dir + "/";
+  return {d + "identity_ca.cert.pem", d + "permissions_ca.cert.pem", d + "governance.p7s",
+          d + security_role + ".permissions.p7s", d + security_role + ".cert.pem", d + security_role + ".key.pem"};
+}
+
+void default_security_role(DdsConfig& c, const std::string& role) {
+  if (c.security_role.empty()) c.security_role = role;
+}
+
+std::string drone_partition(int drone_id) { return "drone/" + std::to_string(drone_id); }
 
 void add_dds_options(CLI::App& app, DdsConfig& c) {
   app.add_option("--domain", c.domain_id, "DDS domain id (0-232)");
@@ -117,6 +147,15 @@ void add_dds_options(CLI::App& app, DdsConfig& c) {
       ->group("Networking (default: this machine only)");
   app.add_option("--participant-id", c.participant_id, "RTPS participant id (-1 automatic)")
       ->group("Networking (default: this machine only)");
+  app.add_option("--secure", c.security_dir,
+                 "DDS Security: authenticate, access-control and encrypt with the credentials in DIR "
+                 "(made by scripts/make-certs)")
+      ->type_name("DIR")
+      ->group("Security (docs/security.md)");
+  app.add_option("--security-role", c.security_role,
+                 "with --secure: the identity to use (default: this program's role)")
+      ->type_name("NAME")
+      ->group("Security (docs/security.md)");
 }
 
 }  // namespace ddswarm
@@ -132,5 +171,7 @@ void merge_cli(DdsConfig& target, const DdsConfig& cli, const CLI::App& app) {
   if (app.count("--dds-interface") || app.count("--dds-local-ip")) target.interface_ip = cli.interface_ip;
   if (app.count("--dds-profiles")) target.profiles_file = cli.profiles_file;
   if (app.count("--participant-id")) target.participant_id = cli.participant_id;
+  if (app.count("--secure")) target.security_dir = cli.security_dir;
+  if (app.count("--security-role")) target.security_role = cli.security_role;
 }
 }  // namespace ddswarm

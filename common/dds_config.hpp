@@ -32,14 +32,32 @@ struct DdsConfig {
   int participant_id = -1;            ///< RTPS participant id, -1 = automatic; set explicitly past ~100 participants per host
   double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement
   std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles
+  /// --secure: a directory made by scripts/make-certs; empty = DDS Security off
+  /// (docs/security.md). With it, the participant authenticates (PKI-DH), is
+  /// access controlled (signed governance and permissions) and encrypts (AES-GCM).
+  std::string security_dir;
+  /// --security-role: which identity in security_dir to use (server, gs,
+  /// recorder, viewer, agent-K); every binary defaults it to what it is.
+  std::string security_role;
 
   void validate() const;  ///< throws FieldError("dds.…")
+  bool secure() const { return !security_dir.empty(); }
+  /// The files security_dir must hold for security_role, in order: identity
+  /// CA, permissions CA, governance, permissions, certificate, private key.
+  std::vector<std::string> security_files() const;
 };
+
+/// Sets c.security_role to role unless the user chose one (--security-role).
+void default_security_role(DdsConfig& c, const std::string& role);
+
+/// The partition a drone's velocity commands travel in under DDS Security
+/// (only agent-K may publish in drone/K; see docs/security.md).
+std::string drone_partition(int drone_id);
 
 void load(YamlSection s, DdsConfig& c);
 
-/// Adds --domain, --dds-interface, --dds-peers, --discovery-server, --dds-profiles
-/// to a CLI11 app; their values override the YAML's after parsing.
+/// Adds --domain, --dds-interface, --dds-peers, --discovery-server, --dds-profiles,
+/// --secure, --security-role to a CLI11 app; their values override the YAML's after parsing.
 void add_dds_options(CLI::App& app, DdsConfig& c);
 
 }  // namespace ddswarm

@@ -5,6 +5,8 @@
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
+#include <filesystem>
+
 namespace ddswarm {
 namespace {
 
@@ -31,6 +33,23 @@ Locator_t udp_locator(const std::string& ip, uint32_t port) {
   IPLocator::setIPv4(l, ip);
   l.port = port;
   return l;
+}
+
+/// DDS Security's three built-in plugins with the role's credentials
+/// (docs/security.md). Fast DDS wants absolute file:// URIs.
+void add_security(const DdsConfig& cfg, fdds::DomainParticipantQos& qos) {
+  const auto f = cfg.security_files();
+  auto uri = [](const std::string& p) { return "file://" + std::filesystem::absolute(p).lexically_normal().string(); };
+  auto& props = qos.properties().properties();
+  props.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+  props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", uri(f[0]));
+  props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", uri(f[4]));
+  props.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", uri(f[5]));
+  props.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
+  props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", uri(f[1]));
+  props.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", uri(f[2]));
+  props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions", uri(f[3]));
+  props.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
 }
 
 /// Builds participant QoS whose every transport is bound to what cfg allows.
@@ -100,6 +119,7 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
     qos.transport().user_transports.push_back(shm);
   }
   qos.transport().user_transports.push_back(udp);
+  if (cfg.secure()) add_security(cfg, qos);
   return qos;
 }
 
@@ -109,17 +129,57 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   cfg.validate();
   load_profiles_once(cfg.profiles_file);
   auto* factory = fdds::DomainParticipantFactory::get_instance();
+  secure_ = cfg.secure();
+  role_ = cfg.security_role;
   participant_ = factory->create_participant(cfg.domain_id, make_qos(cfg, name));
   if (!participant_)
-    throw DdsError("cannot create DDS participant on domain " + std::to_string(cfg.domain_id));
+    throw DdsError("cannot create DDS participant on domain " + std::to_string(cfg.domain_id) +
+                   (secure_ ? " with DDS Security as " + role_ + " (credentials in " + cfg.security_dir +
+                                  ": are they from one scripts/make-certs run, valid, for this domain?)"
+                            : std::string()));
   publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
   if (!publisher_ || !subscriber_) throw DdsError("cannot create DDS publisher/subscriber");
 }
 
+fdds::Publisher* Participant::publisher_for(const std::string& partition) {
+  if (partition.empty()) return publisher_;
+  std::lock_guard<std::mutex> lock(mu_);
+  auto& p = partition_publishers_[partition];
+  if (!p) {
+    fdds::PublisherQos qos = fdds::PUBLISHER_QOS_DEFAULT;
+    qos.partition().push_back(partition.c_str());
+    p = participant_->create_publisher(qos);
+    if (!p) throw DdsError("cannot create DDS publisher for partition " + partition);
+  }
+  return p;
+}
+
+fdds::Subscriber* Participant::subscriber_for(const std::string& partition) {
+  if (partition.empty()) return subscriber_;
+  std::lock_guard<std::mutex> lock(mu_);
+  auto& s = partition_subscribers_[partition];
+  if (!s) {
+    fdds::SubscriberQos qos = fdds::SUBSCRIBER_QOS_DEFAULT;
+    qos.partition().push_back(partition.c_str());
+    s = participant_->create_subscriber(qos);
+    if (!s) throw DdsError("cannot create DDS subscriber for partition " + partition);
+  }
+  return s;
+}
+
+std::string Participant::refused_hint(const std::string& partition) const {
+  if (!secure_) return "";
+  return " (DDS Security: does role " + role_ + "'s grant allow it" +
+         (partition.empty() ? std::string() : " in partition " + partition) + "? see docs/security.md)";
+}
+
 void Participant::close() {
   if (participant_ && !closed_) participant_->delete_contained_entities();
   closed_ = true;
+  std::lock_guard<std::mutex> lock(mu_);
+  partition_publishers_.clear();
+  partition_subscribers_.clear();
 }
 
 Participant::~Participant() {

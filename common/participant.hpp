@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -93,21 +94,25 @@ class Participant {
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
 
+  /// A writer in the default partition, or in partition (e.g. drone_partition(k)).
   template <class T>
-  Writer<T> writer() {
+  Writer<T> writer(const std::string& partition = "") {
     auto* topic = topic_for<T>();
-    auto* w = publisher_->create_datawriter_with_profile(topic, Topic<T>::profile);
-    if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name);
+    auto* w = publisher_for(partition)->create_datawriter_with_profile(topic, Topic<T>::profile);
+    if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name + refused_hint(partition));
     return Writer<T>(w);
   }
 
   /// Creates a reader whose handler runs on a Fast DDS thread for each sample.
+  /// partition may be a pattern ("drone/*"); by default a per-drone topic
+  /// (kPerDronePartition) is read from every drone's partition when secure.
   template <class T>
-  Reader<T>& reader(SampleHandler<T> handler) {
+  Reader<T>& reader(SampleHandler<T> handler, std::optional<std::string> partition_opt = std::nullopt) {
+    const std::string partition = partition_opt.value_or(secure_ && kPerDronePartition<T> ? "drone/*" : "");
     auto* topic = topic_for<T>();
     auto listener = std::make_unique<Reader<T>>(std::move(handler));
-    auto* r = subscriber_->create_datareader_with_profile(topic, Topic<T>::profile, listener.get());
-    if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name);
+    auto* r = subscriber_for(partition)->create_datareader_with_profile(topic, Topic<T>::profile, listener.get());
+    if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));
     listener->attach(r);
     auto& ref = *listener;
     listeners_.push_back(std::move(listener));
@@ -115,8 +120,15 @@ class Participant {
   }
 
   fdds::DomainParticipant* raw() const { return participant_; }
+  /// True when DDS Security is on (DdsConfig::security_dir).
+  bool secure() const { return secure_; }
 
  private:
+  fdds::Publisher* publisher_for(const std::string& partition);
+  fdds::Subscriber* subscriber_for(const std::string& partition);
+  /// Under DDS Security, why creating an endpoint may fail; empty otherwise.
+  std::string refused_hint(const std::string& partition) const;
+
   template <class T>
   fdds::Topic* topic_for() {
     std::lock_guard<std::mutex> lock(mu_);
@@ -134,8 +146,12 @@ class Participant {
 
   fdds::DomainParticipant* participant_ = nullptr;
   bool closed_ = false;
+  bool secure_ = false;
+  std::string role_;
   fdds::Publisher* publisher_ = nullptr;
   fdds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, fdds::Publisher*> partition_publishers_;    // guarded by mu_
+  std::map<std::string, fdds::Subscriber*> partition_subscribers_;  // guarded by mu_
   std::mutex mu_;
   std::map<std::string, fdds::Topic*> topics_;
   std::vector<std::unique_ptr<fdds::DataReaderListener>> listeners_;

@@ -41,6 +41,14 @@ DDSWARM_TOPIC(Beacon, "ddswarm/beacon", "state_keyed");
 
 #undef DDSWARM_TOPIC
 
+/// Topics whose writers publish in their drone's partition (drone_partition())
+/// under DDS Security, so permissions can say whose drone a writer may
+/// address; readers then subscribe to "drone/*" (docs/security.md).
+template <class T>
+inline constexpr bool kPerDronePartition = false;
+template <>
+inline constexpr bool kPerDronePartition<msg::VelocityCommand> = true;
+
 /// Calls f.template operator()<T>() for every message type that has a topic
 /// (for tools that handle all of them: recorder, replay).
 template <class F>

@@ -100,6 +100,14 @@ int main(int argc, char** argv) {
     app.add_option("--set", sets,
                    "override a scenario key for this run, e.g. --set comm.latency_s=0.3 (repeatable)");
     add_dds_options(app, dds_cli);
+    // The launcher's own --discovery-server: it may run the server itself.
+    app.remove_option(app.get_option("--discovery-server"));
+    std::string ds_text = "auto";
+    app.add_option("--discovery-server", ds_text,
+                   fmt::format("Fast DDS discovery server: auto (start one on 127.0.0.1 above {} drones), "
+                               "on (always start one), off, or IP:PORT of a running one",
+                               kAutoDiscoveryServerAbove))
+        ->group("Networking (default: this machine only)");
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -139,9 +147,19 @@ int main(int argc, char** argv) {
           throw FieldError("--ids", ids_text, e.what());
         }
     }
+    DiscoveryServerChoice ds;
+    try {
+      ds = parse_discovery_server(ds_text);
+    } catch (const std::invalid_argument&) {
+      throw FieldError("--discovery-server", ds_text, "must be auto, on, off or IPv4:port");
+    }
     // Flags every child shares: the domain and the network opt-ins, verbatim.
     std::vector<std::string> dds_args;
-    for (const char* opt : {"--domain", "--dds-interface", "--dds-local-ip", "--discovery-server",
+    if (ds.kind == DiscoveryServerChoice::Kind::kExternal) {
+      dds_args.push_back("--discovery-server");
+      dds_args.push_back(ds.address);
+    }
+    for (const char* opt : {"--domain", "--dds-interface", "--dds-local-ip",
                             "--dds-profiles", "--dds-peers"}) {
       if (app.count(opt)) {
         auto* o = app.get_option(opt);
@@ -155,6 +173,18 @@ int main(int argc, char** argv) {
     install_stop_signals();
     const bool stop_on_death = on_death == "stop";
     Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
+    const bool localhost_discovery = file.dds.discovery == Discovery::kLocalhost &&
+                                     !app.count("--dds-interface") && !app.count("--dds-peers");
+    if (wants_local_discovery_server(ds, n, only == "all" && ids_text.empty(), localhost_discovery)) {
+      // First, so every participant finds it; clients retry until it answers.
+      const int port = free_udp_port();
+      procs.start(discovery_server_spec(port));
+      const std::string address = "127.0.0.1:" + std::to_string(port);
+      dds_args.push_back("--discovery-server");
+      dds_args.push_back(address);
+      std::cerr << "ddswarm-launch: discovery server on " << address
+                << " (other tools join with --discovery-server " << address << ")\n";
+    }
     if (!record_dir.empty()) {
       // First, so it hears everything; SIGTERM at the end makes it finalize the file.
       std::filesystem::create_directories(record_dir);

@@ -1,13 +1,17 @@
 #include "ground_station/launcher.hpp"
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -251,6 +255,70 @@ std::vector<int> parse_id_ranges(const std::string& text, int max_exclusive) {
   }
   if (ids.empty()) bad("no ids");
   return ids;
+}
+
+DiscoveryServerChoice parse_discovery_server(const std::string& text) {
+  DiscoveryServerChoice c;
+  if (text == "auto") return c;
+  if (text == "on") {
+    c.kind = DiscoveryServerChoice::Kind::kOn;
+    return c;
+  }
+  if (text == "off") {
+    c.kind = DiscoveryServerChoice::Kind::kOff;
+    return c;
+  }
+  auto colon = text.find(':');
+  in_addr a{};
+  const std::string host = text.substr(0, colon);
+  bool port_ok = colon != std::string::npos && colon + 1 < text.size() &&
+                 text.find_first_not_of("0123456789", colon + 1) == std::string::npos &&
+                 text.size() - colon - 1 <= 5 && std::stoi(text.substr(colon + 1)) > 0 &&
+                 std::stoi(text.substr(colon + 1)) < 65536;
+  if (inet_pton(AF_INET, host.c_str(), &a) != 1 || !port_ok)
+    throw std::invalid_argument("--discovery-server " + text + ": must be auto, on, off or IPv4:port");
+  c.kind = DiscoveryServerChoice::Kind::kExternal;
+  c.address = text;
+  return c;
+}
+
+bool wants_local_discovery_server(const DiscoveryServerChoice& c, int drones, bool starts_whole_swarm,
+                                  bool localhost_discovery) {
+  switch (c.kind) {
+    case DiscoveryServerChoice::Kind::kOn: return true;
+    case DiscoveryServerChoice::Kind::kAuto:
+      return drones > kAutoDiscoveryServerAbove && starts_whole_swarm && localhost_discovery;
+    default: return false;
+  }
+}
+
+ChildSpec discovery_server_spec(int port) {
+  std::string exe;
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path ? path : "/usr/bin:/bin");
+  std::string dir;
+  while (exe.empty() && std::getline(dirs, dir, ':'))
+    if (access((dir + "/fast-discovery-server").c_str(), X_OK) == 0) exe = dir + "/fast-discovery-server";
+  if (exe.empty())
+    throw std::runtime_error(
+        "fast-discovery-server not found (Debian package fastdds-tools; ./scripts/setup installs it)");
+  return {"discovery-server",
+          {exe, "-i", "0", "-l", "127.0.0.1", "-p", std::to_string(port), "-x",
+           std::string(DDSWARM_CONFIG_DIR) + "/discovery_server.xml"}};
+}
+
+int free_udp_port() {
+  int s = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (s < 0) throw std::runtime_error("cannot open a UDP socket to find a free port");
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  bool ok = bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
+            getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) == 0;
+  close(s);
+  if (!ok) throw std::runtime_error("cannot find a free UDP port on 127.0.0.1");
+  return ntohs(a.sin_port);
 }
 
 }  // namespace ddswarm::gs

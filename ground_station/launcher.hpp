@@ -73,4 +73,39 @@ class Launcher {
 /// Parses "3-5,7" into {3,4,5,7}; throws std::invalid_argument naming the text.
 std::vector<int> parse_id_ranges(const std::string& text, int max_exclusive);
 
+/// The launcher's --discovery-server: whether it runs a Fast DDS discovery
+/// server for the swarm, or points every child at one elsewhere.
+struct DiscoveryServerChoice {
+  enum class Kind {
+    kAuto,      ///< start a local server when the swarm is large enough for it to help
+    kOn,        ///< always start a local server
+    kOff,       ///< never: simple discovery (or what the scenario's dds section says)
+    kExternal,  ///< use the server at `address` (ip:port), started by someone else
+  };
+  Kind kind = Kind::kAuto;
+  std::string address;  ///< kExternal: "ip:port"
+};
+
+/// Parses auto | on | off | IP:PORT; throws std::invalid_argument naming the text.
+DiscoveryServerChoice parse_discovery_server(const std::string& text);
+
+/// With auto, swarms of more than this many drones get a local discovery
+/// server: simple discovery is O(N^2) and above ~32 processes the server
+/// discovers faster and idles cheaper (docs/performance.md, bench/dds_floor).
+constexpr int kAutoDiscoveryServerAbove = 32;
+
+/// True when the launcher should start its own server. `starts_whole_swarm`:
+/// it starts the server and every agent (a local server cannot serve a swarm
+/// split across hosts); `localhost_discovery`: no other network was opted into.
+bool wants_local_discovery_server(const DiscoveryServerChoice& c, int drones, bool starts_whole_swarm,
+                                  bool localhost_discovery);
+
+/// fast-discovery-server on 127.0.0.1:port only (config/discovery_server.xml
+/// keeps its transports off every other interface). Throws std::runtime_error
+/// when the program is not installed.
+ChildSpec discovery_server_spec(int port);
+
+/// A UDP port on 127.0.0.1 that was free a moment ago.
+int free_udp_port();
+
 }  // namespace ddswarm::gs

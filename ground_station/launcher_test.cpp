@@ -62,3 +62,24 @@ TEST(Launcher, MissingProgramIsAClearError) {
     EXPECT_NE(std::string(e.what()).find("/no/such/program"), std::string::npos);
   }
 }
+
+TEST(Launcher, DiscoveryServerChoice) {
+  using K = DiscoveryServerChoice::Kind;
+  EXPECT_EQ(parse_discovery_server("auto").kind, K::kAuto);
+  EXPECT_EQ(parse_discovery_server("on").kind, K::kOn);
+  EXPECT_EQ(parse_discovery_server("off").kind, K::kOff);
+  auto ext = parse_discovery_server("10.0.0.2:11811");
+  EXPECT_EQ(ext.kind, K::kExternal);
+  EXPECT_EQ(ext.address, "10.0.0.2:11811");
+  for (const char* bad : {"", "yes", "10.0.0.2", "10.0.0.2:", "10.0.0.2:x", "10.0.0.2:70000", "host:11811"})
+    EXPECT_THROW(parse_discovery_server(bad), std::invalid_argument) << bad;
+  // auto: only a large swarm whose every process this launcher starts on this machine.
+  const auto a = parse_discovery_server("auto");
+  EXPECT_FALSE(wants_local_discovery_server(a, kAutoDiscoveryServerAbove, true, true));
+  EXPECT_TRUE(wants_local_discovery_server(a, kAutoDiscoveryServerAbove + 1, true, true));
+  EXPECT_FALSE(wants_local_discovery_server(a, 128, false, true));
+  EXPECT_FALSE(wants_local_discovery_server(a, 128, true, false));
+  EXPECT_TRUE(wants_local_discovery_server(parse_discovery_server("on"), 1, true, true));
+  EXPECT_FALSE(wants_local_discovery_server(parse_discovery_server("off"), 128, true, true));
+  EXPECT_FALSE(wants_local_discovery_server(ext, 128, true, true));
+}

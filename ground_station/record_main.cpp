@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     opt.chunk_bytes = chunk_kb * 1024;
+    ddswarm::default_security_role(dds, "recorder");
     ddswarm::install_stop_signals();
     ddswarm::gs::Recorder rec(dds, opt);
     std::fprintf(stderr, "ddswarm-record: recording to %s (Ctrl-C to stop)\n", opt.path.c_str());

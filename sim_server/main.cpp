@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
     if (drones) cfg.scenario.drones = *drones;
     if (mode) cfg.scenario.mode = *mode == "lockstep" ? ddswarm::TimeMode::kLockstep : ddswarm::TimeMode::kRealtime;
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
+    ddswarm::default_security_role(cfg.dds, "server");
     cfg.validate();
     ddswarm::install_stop_signals();
     ddswarm::sim::SimServer server(std::move(cfg));
