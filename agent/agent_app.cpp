@@ -295,6 +295,11 @@ struct AgentApp::Impl {
     others.clear();
     for (const auto& d : s.drones()) {
       if (d.drone_id() == id) continue;
+      // A drone without a live agent (lost: the server's failsafe flies it,
+      // hovering then landing) is no member of the swarm: no attraction to
+      // it, or the swarm would stay tied to a wreck. The distance sensors
+      // still see it as an obstacle.
+      if (!(d.flags() & msg::DRONE_AGENT_LIVE) || (d.flags() & msg::DRONE_FAILSAFE)) continue;
       if (!finite(d.position())) {
         ++rejected;
         continue;

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Issue 9: an agent is killed (SIGKILL) mid-task. Its drone enters failsafe
+# (hovers, then lands after sim.failsafe_land_after_s), lockstep does not
+# deadlock, the other five complete the task and the lost drone is reported.
+# Restarted with the same id, the agent rejoins: it catches up with the
+# mission in force from the server's ring and its drone flies it again.
+source "$(dirname "$0")/lib.sh"
+scenario="$SRC/config/thesis_course.yaml"
+gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
+start launch "$BIN/ddswarm-launch" "$scenario" --mode lockstep --domain "$DOMAIN" --ids 0-2,4-5 \
+  --set sim.agent_timeout_s=1 --set sim.failsafe_land_after_s=5 --log-dir "$WORK"
+start agent3 "$BIN/ddswarm-agent" --id 3 --config "$scenario" --domain "$DOMAIN"
+gs wait-agents --count 6 --timeout 60 || fail "agents not online"
+gs takeoff --wait || fail "takeoff"
+start trace "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" trace --out "$WORK/trace.csv"
+sleep 1
+gs task --no-wait || fail "task not accepted"
+kill -KILL "$PID_agent3"
+wait "$PID_agent3" 2>/dev/null
+started=$SECONDS
+gs task --attach >"$WORK/result.log" 2>&1; rc=$?
+cat "$WORK/result.log"
+echo "task finished $((SECONDS - started)) s (wall) after the kill"
+[ $rc -eq 0 ] || fail "the task did not complete without drone 3 (exit $rc)"
+grep -q "task complete:" "$WORK/result.log" || fail "no result line"
+grep -q "lost drones (agent lost, failsafe): 3" "$WORK/result.log" || fail "the lost drone is not reported"
+grep -q "drone 3: agent lost" "$WORK/sim.log" || fail "the server did not declare agent 3 lost"
+kill -INT "$PID_trace"; wait_pid "$PID_trace" 10 || fail "trace did not stop"
+# Drone 3 in the trace: failsafe flag (2) from some time t0; at t0 + 4 s it
+# still hovers (z > 1.5 m); at the end it is down (z < 0.3 m), motors off.
+awk -F, 'NR > 1 && $3 == 3 && int($11 / 2) % 2 == 1 { if (t0 == "") t0 = $2; z[$2] = $6; last = $2 }
+         END {
+           if (t0 == "") { print "drone 3 never in failsafe"; exit 1 }
+           best = ""; for (t in z) if (t >= t0 + 4 && t <= t0 + 4.5) best = t
+           if (best == "") { print "no sample 4 s into failsafe"; exit 1 }
+           printf "failsafe from t=%.2f s: z=%.2f m at t=%.2f s, z=%.2f m at t=%.2f s\n", t0, z[best], best, z[last], last
+           exit !(z[best] > 1.5 && z[last] < 0.3) }' "$WORK/trace.csv" || fail "drone 3 did not hover, then land"
+# Rejoin: the same id again. It takes off and resumes the task (past the finish line).
+start agent3b "$BIN/ddswarm-agent" --id 3 --config "$scenario" --domain "$DOMAIN"
+ok=0
+for _ in $(seq 120); do
+  row=$(gs status --drones 2>/dev/null | awk '$1 == 3')
+  if echo "$row" | grep -q "past-finish" && ! echo "$row" | grep -q "failsafe" && echo "$row" | grep -q "airborne"; then ok=1; break; fi
+  sleep 0.5
+done
+echo "drone 3 after rejoining: $row"
+[ $ok -eq 1 ] || fail "the restarted agent did not rejoin the task"
+grep -q "joined mid-mission: caught up with task" "$WORK/agent3b.log" || fail "the agent did not catch up from the ring"
+echo PASS
