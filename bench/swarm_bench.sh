@@ -1,0 +1,254 @@
+#!/usr/bin/env bash
+# Issue 8 (scale): ddswarm's lockstep and real-time figures for N agent
+# processes, each beside the bare Fast DDS floor of the same run, and Table 1's
+# wall time split into start-up, flight and teardown.
+#
+# Usage: bench/swarm_bench.sh [options]
+#   --bin DIR          built binaries (default: build/default/bin)
+#   --out DIR          CSVs, logs and the plot data (default: a temporary directory)
+#   --sizes "6 16 .."  agent-process counts (default: 6 16 32 64 128)
+#   --rt-sizes "..."   real-time counts (default: the same)
+#   --time S           lockstep seconds measured per N (default 10)
+#   --rt-time S        real-time seconds measured per N (default 60)
+#   --floor-time S     floor seconds measured per N (default 5)
+#   --skip floor,lockstep,realtime,table1   parts to leave out
+#   --table1-runs K    runs per set for Table 1 (default 15, the thesis's)
+#   --plot FILE.png    real-time factor against N (gnuplot)
+#   --quick            a smoke run: N = 4 and 8, a few seconds each, 1 run per Table 1 set
+# Every process is started here or by ddswarm-launch and stopped by PID; every
+# run is bounded in time.
+set -u
+SRC="$(cd "$(dirname "$0")/.." && pwd)"
+BIN="$SRC/build/default/bin"
+OUT=""
+SIZES="6 16 32 64 128"
+RT_SIZES=""
+LS_TIME=10
+RT_TIME=60
+FLOOR_TIME=5
+SKIP=""
+T1_RUNS=15
+PLOT=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --bin) BIN="$2"; shift 2 ;;
+    --out) OUT="$2"; shift 2 ;;
+    --sizes) SIZES="$2"; shift 2 ;;
+    --rt-sizes) RT_SIZES="$2"; shift 2 ;;
+    --time) LS_TIME="$2"; shift 2 ;;
+    --rt-time) RT_TIME="$2"; shift 2 ;;
+    --floor-time) FLOOR_TIME="$2"; shift 2 ;;
+    --skip) SKIP="$2"; shift 2 ;;
+    --table1-runs) T1_RUNS="$2"; shift 2 ;;
+    --plot) PLOT="$2"; shift 2 ;;
+    --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; shift ;;
+    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    *) echo "swarm_bench: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+RT_SIZES="${RT_SIZES:-$SIZES}"
+BIN="$(cd "$BIN" && pwd)" || { echo "swarm_bench: no binaries in $BIN" >&2; exit 2; }
+for b in ddswarm-launch ddswarm-gs ddswarm-sim ddswarm-agent dds_floor swarm_probe; do
+  [ -x "$BIN/$b" ] || { echo "swarm_bench: $BIN/$b missing (build targets dds_floor swarm_probe and the ddswarm binaries)" >&2; exit 2; }
+done
+TMP_OUT=0
+if [ -z "$OUT" ]; then OUT="$(mktemp -d /tmp/ddswarm-bench.XXXXXX)"; TMP_OUT=1; fi
+mkdir -p "$OUT"
+skip() { [[ ",$SKIP," == *",$1,"* ]]; }
+SCENARIO="$SRC/config/thesis_course.yaml"
+PY=/usr/bin/python3
+
+LAUNCH_PID=""
+cleanup() {
+  if [ -n "$LAUNCH_PID" ] && kill -0 "$LAUNCH_PID" 2>/dev/null; then
+    kill -TERM "$LAUNCH_PID" 2>/dev/null
+    for _ in $(seq 100); do kill -0 "$LAUNCH_PID" 2>/dev/null || break; sleep 0.1; done
+    kill -KILL "$LAUNCH_PID" 2>/dev/null
+  fi
+  [ "$TMP_OUT" = 1 ] && [ "${KEEP:-0}" != 1 ] && rm -rf "$OUT"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+echo "swarm_bench: load before start: $(cut -d' ' -f1-3 /proc/loadavg); results in $OUT"
+
+# ---------------------------------------------------------------- floor
+FLOOR_CSV="$OUT/floor.csv"
+if ! skip floor; then
+  rm -f "$FLOOR_CSV"
+  "$BIN/dds_floor" --drones "$(echo $SIZES | tr ' ' ',')" --discovery both --time "$FLOOR_TIME" \
+    --csv "$FLOOR_CSV" --log-dir "$OUT/floor-logs"
+fi
+# floor_of N: ticks/s of the floor with the discovery the launcher's auto picks.
+floor_of() {
+  [ -f "$FLOOR_CSV" ] || { echo nan; return; }
+  $PY - "$FLOOR_CSV" "$1" <<'EOF'
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if int(r["n"]) == int(sys.argv[2]) and r["ok"] == "1"]
+want = "server" if int(sys.argv[2]) > 32 else "simple"
+pick = [r for r in rows if r["discovery"] == want] or rows
+print(pick[0]["ticks_per_s"] if pick else "nan")
+EOF
+}
+
+# ---------------------------------------------------------------- one swarm
+# run_swarm MODE N SECONDS: launches N agents, takes off, holds, probes; prints the probe line.
+run_swarm() {
+  local mode="$1" n="$2" secs="$3"
+  local dom=$(( (RANDOM % 100) + 120 )) log="$OUT/$mode-$n"
+  rm -rf "$log"; mkdir -p "$log"
+  local bound=$(( secs + 400 ))
+  local t0; t0=$(date +%s.%N)
+  "$BIN/ddswarm-launch" "$SCENARIO" --drones "$n" --mode "$mode" --domain "$dom" --log-dir "$log" \
+    --discovery-server auto --duration "$bound" >"$log/launch.out" 2>"$log/launch.err" &
+  LAUNCH_PID=$!
+  local ds=()
+  for _ in $(seq 50); do
+    grep -q "started .* process" "$log/launch.err" 2>/dev/null && break; sleep 0.1
+  done
+  local addr; addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$log/launch.err")
+  [ -n "$addr" ] && ds=(--discovery-server "$addr")
+  local gs=("$BIN/ddswarm-gs" --config "$SCENARIO" --domain "$dom" "${ds[@]}")
+  local up="nan" why=""
+  if timeout 320 "${gs[@]}" wait-agents --count "$n" --timeout 300 >"$log/gs-wait.log" 2>&1; then
+    up=$(echo "$(date +%s.%N) - $t0" | bc)
+  else
+    why="agents not online: $(tail -1 "$log/gs-wait.log")"
+  fi
+  local probe_args=(--drones "$n" --launcher-pid "$LAUNCH_PID" --domain "$dom" "${ds[@]}" --time "$secs"
+                    --settle 3 --timeout 240)
+  [ "$mode" = realtime ] && probe_args+=(--ages)
+  local line=""
+  if [ -z "$why" ]; then
+    "$BIN/swarm_probe" "${probe_args[@]}" >"$log/probe.out" 2>"$log/probe.err" &
+    local probe=$!
+    if timeout 260 "${gs[@]}" takeoff --wait >"$log/gs-takeoff.log" 2>&1; then
+      local hold=86400
+      [ "$mode" = realtime ] && hold=$(( secs + 60 ))
+      timeout 60 "${gs[@]}" hold --time "$hold" >"$log/gs-hold.log" 2>&1 || why="hold failed: $(tail -1 "$log/gs-hold.log")"
+    else
+      why="takeoff failed: $(tail -1 "$log/gs-takeoff.log")"
+    fi
+    local end=$((SECONDS + secs + 300))
+    while kill -0 "$probe" 2>/dev/null && [ $SECONDS -lt $end ]; do sleep 0.2; done
+    kill -KILL "$probe" 2>/dev/null
+    wait "$probe" 2>/dev/null
+    line=$(grep '^probe ' "$log/probe.out" | tail -1)
+    [ -z "$line" ] && why="${why:-probe failed: $(tail -1 "$log/probe.err")}"
+  fi
+  kill -TERM "$LAUNCH_PID" 2>/dev/null
+  for _ in $(seq 150); do kill -0 "$LAUNCH_PID" 2>/dev/null || break; sleep 0.1; done
+  kill -KILL "$LAUNCH_PID" 2>/dev/null
+  wait "$LAUNCH_PID" 2>/dev/null
+  LAUNCH_PID=""
+  echo "mode=$mode n=$n up_s=$up ds=${addr:-none} why=\"$why\" $line"
+}
+
+field() {  # field KEY LINE
+  echo "$2" | tr ' ' '\n' | sed -n "s/^$1=//p" | head -1
+}
+
+# ---------------------------------------------------------------- lockstep
+if ! skip lockstep; then
+  : >"$OUT/lockstep.txt"
+  for n in $SIZES; do
+    echo "swarm_bench: lockstep N=$n (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
+    echo "$(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
+  done
+  echo
+  echo "== lockstep: ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes; ${LS_TIME} s measured while holding =="
+  echo "| N | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  while read -r l; do
+    n=$(field n "$l"); t=$(field ticks_per_s "$l"); f=$(field floor "$l")
+    ratio=$(echo "$t $f" | awk '{ if ($1+0 > 0 && $2+0 > 0) printf "%.2f", $1 / $2; else print "-" }')
+    rtf=$(echo "$t" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')
+    printf "| %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s |\n" "$n" "${t:--}" "$rtf" \
+      "$(echo "$f" | awk '{ printf "%.0f", $1 }')" "$ratio" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
+      "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field rss_agent_mb "$l")" "$(field pss_agent_mb "$l")" \
+      "$(field up_s "$l" | awk '{ printf "%.1f", $1 }')" "$(field load "$l")" \
+      "$(echo "$l" | sed -n 's/.*why="\([^"]*\)".*/\1/p')"
+  done <"$OUT/lockstep.txt"
+fi
+
+# ---------------------------------------------------------------- real time
+if ! skip realtime; then
+  : >"$OUT/realtime.txt"
+  for n in $RT_SIZES; do
+    echo "swarm_bench: real time N=$n, ${RT_TIME} s (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
+    echo "$(run_swarm realtime "$n" "$RT_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/realtime.txt"
+  done
+  echo
+  echo "== real time: ${RT_TIME} s per N; criteria RTF >= 0.99, command age p99 <= 2 periods, missed < 0.1 % =="
+  echo "| N | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agents (each) | CPU discovery server | CPU probe | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | floor RTF (ticks/s / 50) | meets criteria | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  best=0
+  while read -r l; do
+    n=$(field n "$l"); rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l"); mf=$(field missed_frac "$l")
+    ok=$(echo "${rtf:-0} ${p99:-99} ${mf:-1}" | awk '{ print ($1 >= 0.99 && $2 <= 2 && $3 < 0.001) ? "yes" : "no" }')
+    [ "$ok" = yes ] && [ "$n" -gt "$best" ] && best=$n
+    printf "| %s | %s | %s / %s / %s | %s (%s of %s) | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" \
+      "$n" "${rtf:--}" "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
+      "$(echo "${mf:-}" | awk '{ if ($1 != "") printf "%.3f %%", 100 * $1; else print "-" }')" \
+      "$(field missed "$l")" "$(field drone_ticks "$l")" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
+      "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field cpu_probe "$l")" "$(field rss_agent_mb "$l")" \
+      "$(field pss_agent_mb "$l")" "$(field up_s "$l" | awk '{ printf "%.1f", $1 }')" \
+      "$(field floor "$l" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')" "$ok" \
+      "$(field load "$l")" "$(echo "$l" | sed -n 's/.*why="\([^"]*\)".*/\1/p')"
+  done <"$OUT/realtime.txt"
+  echo "largest N meeting the real-time criteria: $best"
+fi
+
+# ---------------------------------------------------------------- plot
+if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
+  : >"$OUT/plot.dat"
+  while read -r l; do
+    echo "$(field n "$l") $(field ticks_per_s "$l") $(field floor "$l")" >>"$OUT/plot.dat"
+  done <"$OUT/lockstep.txt"
+  : >"$OUT/plot_rt.dat"
+  [ -f "$OUT/realtime.txt" ] && while read -r l; do
+    echo "$(field n "$l") $(field rtf "$l")" >>"$OUT/plot_rt.dat"
+  done <"$OUT/realtime.txt"
+  gnuplot <<EOF
+set terminal pngcairo size 900,560 font ",11"
+set output "$PLOT"
+set title "Real-time factor against swarm size (one process per drone, 2 cores)"
+set xlabel "drones (agent processes)"
+set ylabel "real-time factor (sim s per wall s, 50 Hz control)"
+set logscale xy
+set xtics (6, 10, 16, 32, 64, 128)
+set grid
+set key outside right
+plot "$OUT/plot.dat" using 1:(\$3/50) with linespoints lw 2 title "bare Fast DDS floor (ticks/s / 50)", \
+     "$OUT/plot.dat" using 1:(\$2/50) with linespoints lw 2 title "ddswarm lockstep", \
+     "$OUT/plot_rt.dat" using 1:2 with linespoints lw 2 title "ddswarm real time (paced, target 1)", \
+     "-" using 1:2 with points pt 7 ps 1.6 title "gym-pybullet-drones (10, ~2x)", \
+     "-" using 1:2 with points pt 5 ps 1.6 title "SwarmLab (16, ~1x)", \
+     "-" using 1:2 with points pt 9 ps 1.6 title "Crazyswarm2 sim (16, 0.6x)"
+10 2
+e
+16 1
+e
+16 0.6
+e
+EOF
+  echo "plot: $PLOT"
+fi
+
+# ---------------------------------------------------------------- Table 1
+if ! skip table1; then
+  T1="$OUT/table1"
+  rm -rf "$T1"; mkdir -p "$T1"
+  sed -e "s#^\( *scenario:\) *thesis_course.yaml#\1 $SRC/config/thesis_course.yaml#" \
+      -e "s#^\( *runs_per_set:\) *[0-9]*#\1 $T1_RUNS#" "$SRC/config/table1.yaml" >"$T1/table1.yaml"
+  dom=$(( (RANDOM % 100) + 120 ))
+  echo "swarm_bench: Table 1, 4 sets x $T1_RUNS runs (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
+  t0=$(date +%s.%N)
+  timeout $(( 60 * T1_RUNS + 300 )) "$BIN/ddswarm-gs" --domain "$dom" experiment "$T1/table1.yaml" --out "$T1/out" \
+    >"$T1/experiment.log" 2>&1
+  rc=$?
+  total=$(echo "$(date +%s.%N) - $t0" | bc)
+  echo
+  echo "== Table 1: 4 sets x $T1_RUNS lockstep runs of the six-drone task (exit $rc, load $(cut -d' ' -f1 /proc/loadavg)) =="
+  $PY "$SRC/bench/table1_split.py" "$T1/out" "$total"
+fi
