@@ -318,6 +318,10 @@ CommandResult DdsCommander::task(double speed, double eps) {
   return impl_->send(c);
 }
 
+bool DdsCommander::wait_task_status(double timeout_s) {
+  return impl_->wait(timeout_s, [&] { return impl_->task.has_value(); });
+}
+
 bool DdsCommander::attach_task(double timeout_s) {
   auto& I = *impl_;
   bool ok = I.wait(timeout_s, [&] { return I.task && I.task->phase() != msg::TASK_NONE; });
@@ -438,7 +442,7 @@ SwarmStatus DdsCommander::status() {
     s.rejected = {{"non-finite", m.rejected_non_finite()}, {"absurd", m.rejected_absurd()},
                   {"unknown id", m.rejected_unknown_id()}, {"stale tick", m.rejected_stale_tick()},
                   {"future tick", m.rejected_future_tick()}, {"impostor", m.rejected_impostor()},
-                  {"mission", m.rejected_mission()}};
+                  {"mission", m.rejected_mission()}, {"malformed", m.rejected_malformed()}};
   }
   if (!impl_->agents.empty()) {
     std::uint64_t by_agents = 0;

@@ -66,6 +66,9 @@ class DdsCommander final : public Commander {
   /// ground station had started it, so wait_task() reports it: a new ground
   /// station after the first one died. False when no task is heard in timeout_s.
   bool attach_task(double timeout_s);
+  /// Waits until the server's (latched) task status has arrived, if it has
+  /// one. False on timeout (e.g. no task was ever run).
+  bool wait_task_status(double timeout_s);
   SwarmStatus status() override;
 
   /// The last task's outcome, once wait_task() returned.
