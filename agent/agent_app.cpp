@@ -206,7 +206,7 @@ struct AgentApp::Impl {
       s.server_lost(server_lost);
       s.last_tick(last_tick);
       s.inter_distance_m(fsm ? fsm->inter_distance_m() : cfg.agent.inter_distance_m);
-      s.rejected_samples(static_cast<std::uint32_t>(rejected));
+      s.rejected_samples(static_cast<std::uint32_t>(rejected + malformed_samples().load()));
       s.commands_sent(static_cast<std::uint32_t>(sent));
     }
     w_status.write(s);

@@ -13,7 +13,37 @@
 #include "TaskStatusPubSubTypes.h"
 #include "VelocityCommandPubSubTypes.h"
 
+#include <fastcdr/exceptions/Exception.h>
+
+#include <atomic>
+#include <cstdint>
+
 namespace ddswarm {
+
+/// Samples refused on the wire in this process (undecodable CDR), every topic.
+inline std::atomic<std::uint64_t>& malformed_samples() {
+  static std::atomic<std::uint64_t> n{0};
+  return n;
+}
+
+/// The generated type support, refusing a malformed sample instead of
+/// throwing. Fast CDR throws BadParamException for, e.g., a bool byte other
+/// than 0 or 1; the generated deserialize() catches only a truncated buffer,
+/// so one such sample from any participant on the domain escaped into Fast
+/// DDS's reader thread and terminated the process. Now deserialize() returns
+/// false (Fast DDS drops the sample) and malformed_samples() counts it.
+template <class Generated>
+class SafePubSub : public Generated {
+ public:
+  bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override {
+    try {
+      if (Generated::deserialize(payload, data)) return true;
+    } catch (const eprosima::fastcdr::exception::Exception&) {
+    }
+    malformed_samples().fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+};
 
 template <class T>
 struct Topic;
@@ -21,7 +51,7 @@ struct Topic;
 #define DDSWARM_TOPIC(Type, topic_name, qos_profile)            \
   template <>                                                    \
   struct Topic<msg::Type> {                                      \
-    using PubSub = msg::Type##PubSubType;                        \
+    using PubSub = SafePubSub<msg::Type##PubSubType>;            \
     static constexpr const char* name = topic_name;              \
     static constexpr const char* profile = qos_profile;          \
   }

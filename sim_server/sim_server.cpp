@@ -609,6 +609,7 @@ struct SimServer::Impl {
         if (slots[i].live) s.live_agents().push_back(static_cast<std::uint16_t>(i));
       s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
     }
+    s.rejected_malformed(static_cast<std::uint32_t>(malformed_samples().load()));
     s.tick(tick);
     s.sim_time_s(sim_time());
     s.wall_time_s(now - start_wall);

@@ -9,3 +9,8 @@ ddswarm_process_test(mp_duplicate_agent 40 duplicate_agent_test.sh)
 ddswarm_process_test(mp_config_errors 60 config_errors_test.sh)
 ddswarm_process_test(mp_network_safety 60 network_safety_test.sh)
 set_tests_properties(mp_network_safety PROPERTIES SKIP_RETURN_CODE 77)
+
+# Samples malformed on the wire (a bool byte of 2): refused, counted, never fatal.
+add_executable(malformed_publisher malformed_publisher.cpp)
+target_link_libraries(malformed_publisher PRIVATE ddswarm_common)
+ddswarm_process_test(mp_malformed_samples 60 malformed_samples_test.sh)
