@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "agent/agent_app.hpp"
+#include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
 #include "common/process.hpp"
 
@@ -18,7 +19,8 @@ int main(int argc, char** argv) {
     ddswarm::DdsConfig dds_cli;
     app.add_option("--id", id, "drone id to fly")->required();
     app.add_option("--config,config", config, "scenario YAML (its agent: section)")->required();
-    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = until Ctrl-C)");
+    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = until Ctrl-C)")
+        ->check(ddswarm::finite_range(0.0, 1e9));
     app.add_option("--drones", drones, "override scenario.drones");
     ddswarm::add_dds_options(app, dds_cli);
     try {

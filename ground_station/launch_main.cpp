@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "common/cli_checks.hpp"
 #include "common/process.hpp"
 #include "ground_station/experiment_config.hpp"
 #include "ground_station/gs_app.hpp"
@@ -93,7 +94,8 @@ int main(int argc, char** argv) {
                    "everything stops when they finish");
     app.add_flag("--gs-interactive", gs_interactive, "open the ground-station console here");
     app.add_option("--log-dir", log_dir, "write each process's log to DIR/<name>.log instead of the terminal");
-    app.add_option("--duration", duration_s, "stop everything after this many wall seconds");
+    app.add_option("--duration", duration_s, "stop everything after this many wall seconds")
+        ->check(finite_range(0.0, 1e9));
     std::string record_dir;
     app.add_option("--record", record_dir, "record the run's DDS traffic to DIR/run-<time>.mcap");
     std::vector<std::string> sets;

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "common/cli_checks.hpp"
 #include "common/process.hpp"
 #include "ground_station/recorder.hpp"
 
@@ -17,7 +18,8 @@ int main(int argc, char** argv) {
     ddswarm::DdsConfig dds;
     app.add_option("-o,--output", opt.path, "output .mcap file");
     app.add_option("--topics", opt.topics, "topics to record (default: all)")->delimiter(',');
-    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = until Ctrl-C)");
+    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = until Ctrl-C)")
+        ->check(ddswarm::finite_range(0.0, 1e9));
     app.add_option("--compression", opt.compression, "chunk compression")
         ->check(CLI::IsMember({"zstd", "lz4", "none"}));
     app.add_option("--chunk-kb", chunk_kb, "uncompressed KiB per chunk (a crash loses at most one)")

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "common/cli_checks.hpp"
 #include "common/process.hpp"
 #include "ground_station/recorder.hpp"
 
@@ -16,7 +17,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> topics;
     ddswarm::DdsConfig dds;
     app.add_option("file", path, "recording")->required();
-    app.add_option("--rate", rate, "playback speed (2 = twice as fast)")->check(CLI::PositiveNumber);
+    app.add_option("--rate", rate, "playback speed (2 = twice as fast)")->check(ddswarm::finite_positive());
     app.add_flag("--loop", loop, "start again at the end, until Ctrl-C");
     app.add_option("--topics", topics, "topics to replay (default: all)")->delimiter(',');
     ddswarm::add_dds_options(app, dds);

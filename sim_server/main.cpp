@@ -4,6 +4,7 @@
 
 #include <optional>
 
+#include "common/cli_checks.hpp"
 #include "common/process.hpp"
 #include "sim_server/sim_server.hpp"
 
@@ -17,7 +18,8 @@ int main(int argc, char** argv) {
     std::optional<std::string> mode;
     ddswarm::DdsConfig dds_cli;
     app.add_option("--scenario,scenario", scenario, "scenario YAML")->required();
-    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = run until Ctrl-C)");
+    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = run until Ctrl-C)")
+        ->check(ddswarm::finite_range(0.0, 1e9));
     app.add_option("--seed", seed, "override scenario.seed");
     app.add_option("--drones", drones, "override scenario.drones");
     app.add_option("--mode", mode, "override scenario.mode")->check(CLI::IsMember({"realtime", "lockstep"}));
