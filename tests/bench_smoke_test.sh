@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Issue 8: the scale benches run and print their tables (bench/swarm_bench.sh
+# --quick at tiny N). No timed assertion: figures are printed, never judged.
+source "$(dirname "$0")/lib.sh"
+start bench bash "$SRC/bench/swarm_bench.sh" --bin "$BIN" --quick --sizes 3 --out "$WORK/out"
+wait_pid "$PID_bench" 400; rc=$?
+out="$WORK/bench.log"
+[ $rc -eq 0 ] || fail "swarm_bench exit $rc"
+for title in "bare Fast DDS lockstep floor" "== lockstep:" "== real time:" "== Table 1:"; do
+  grep -q -- "$title" "$out" || fail "no '$title' table"
+done
+# Each table has a row for N = 3 with a figure in it, and Table 1 its split.
+grep -Eq '^\| 3 \| simple \| [0-9]+ \|' "$out" || fail "floor row for N=3 missing or empty"
+grep -Eq '^\| 3 \| [0-9.]+ \| [0-9.]+ \|' "$out" || fail "lockstep row for N=3 missing or empty"
+grep -Eq '^\| 3 \| [0-9.]+ \| [0-9]+ / [0-9]+ / [0-9]+ \|' "$out" || fail "real-time row for N=3 missing or empty"
+grep -Eq '^\| task flight \| [0-9.]+ \|' "$out" || fail "Table 1 split missing"
+grep -q "4 runs, 0 failed" "$out" || fail "Table 1 quick runs failed"
+echo PASS
