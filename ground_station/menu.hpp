@@ -53,4 +53,9 @@ int run_menu(Commander& commander, LineReader& reader, std::ostream& out,
 /// "[sim 12.3 s | x1.00 real time | drones 6/6 online | 6 airborne | 0 collisions | ...]".
 std::string format_status(const SwarmStatus& s);
 
+/// "rejected samples: 7 (non-finite 2, absurd 1, ..., agents 0)": what the
+/// server and the agents refused, by reason; "rejected samples: unknown" when
+/// nothing was heard yet.
+std::string format_rejections(const SwarmStatus& s);
+
 }  // namespace ddswarm::gs

@@ -5,7 +5,8 @@
 # malformed mission commands. Every matching SimStatus rejected_* counter must
 # grow and the drone must keep hovering within 0.1 m of 2 m: the commander
 # checks its whole hold, the attacker watches the attack window (height,
-# drift, speed, failsafe, the legitimate agent's liveness).
+# drift, speed, failsafe, the legitimate agent's liveness). Afterwards
+# `ddswarm-gs status` must show every reason's count above zero.
 source "$(dirname "$0")/lib.sh"
 start sim "$BIN/ddswarm-sim" --scenario "$SRC/tests/scenarios/one_drone.yaml" --mode realtime \
   --domain "$DOMAIN" --duration 50
@@ -20,4 +21,11 @@ cat "$WORK/commander.log"
 [ $hostile_rc -eq 0 ] || fail "hostile samples were not all rejected, or they disturbed the drone (exit $hostile_rc)"
 [ $commander_rc -eq 0 ] || fail "the legitimate commander did not hold 2 m within 0.1 m through the attack (exit $commander_rc)"
 grep -q 'agent .* online' "$WORK/sim.log" || fail "the server never saw the legitimate agent"
+# The operator sees every rejection, by reason, in the ground station's status.
+status=$(timeout 20 "$BIN/ddswarm-gs" --domain "$DOMAIN" status 2>&1) || fail "status failed: $status"
+echo "$status"
+for reason in non-finite absurd 'unknown id' 'stale tick' 'future tick' impostor mission; do
+  n=$(echo "$status" | sed -n "s/.*[(, ]$reason \([0-9]*\)[,)].*/\1/p")
+  [ -n "$n" ] && [ "$n" -gt 0 ] || fail "status does not show the rejected '$reason' samples: $status"
+done
 echo PASS
