@@ -37,6 +37,9 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
   EXPECT_EQ(error_for("sim:\n  colour: red\n"), "2: sim.colour: unknown key");
   EXPECT_EQ(error_for("wings: 2\n"), "1: wings: unknown section");
   EXPECT_EQ(error_for("sensors:\n  count: many\n"), "2: sensors.count = many: must be an integer");
+  EXPECT_EQ(error_for("scene:\n  bounds_min: [0, 0, 0]\n  bounds_max: [12, 16, 15]\nsensors:\n  max_range_m: 26\n"),
+            "5: sensors.max_range_m = 26: must be <= the world's size (diagonal of "
+            "scene.bounds_min..bounds_max, 25 m)");
 }
 
 TEST(ServerConfig, MissingFileIsAClearError) {

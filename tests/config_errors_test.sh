@@ -62,6 +62,8 @@ done
 case_ "sim: negative radius" 'bad_negative_radius\.yaml:8:' 'scene\.cylinders\[1\]\.radius_m' '-2\.5' -- run_sim "$S/bad_negative_radius.yaml"
 case_ "sim: rate does not divide" 'bad_rate\.yaml:7:' 'sim\.control_rate_hz' '\b70\b' -- run_sim "$S/bad_rate.yaml"
 case_ "sim: negative sensor range" 'bad_sensor_range\.yaml:7:' 'sensors\.max_range_m' '-6' -- run_sim "$S/bad_sensor_range.yaml"
+case_ "sim: sensor range beyond the world" 'bad_sensor_beyond_world\.yaml:10:' 'sensors\.max_range_m' '\b600\b' "world's size" -- \
+  run_sim "$S/bad_sensor_beyond_world.yaml"
 
 # The agent's own section and its drone id.
 case_ "agent: wrong type" 'bad_agent_wrong_type\.yaml:6:' 'agent\.inter_distance_m' 'far' -- run_agent "$S/bad_agent_wrong_type.yaml"
