@@ -355,6 +355,12 @@ const server = http.createServer((req, res) => {
     });
     return;
   }
+  if (url.pathname === '/api/dev/state') {
+    // Mock only: the truth the browser tests compare the page with.
+    res.setHeader('Content-Type', 'application/json');
+    res.end(JSON.stringify({ tick: swarm.tick, t: swarm.t, airborne: swarm.airborne(), drones: swarm.d.map((a) => ({ id: a.id, p: a.p.map(r4), flags: a.flags })) }));
+    return;
+  }
   if (req.method !== 'GET' && req.method !== 'HEAD') { res.statusCode = 405; res.end(); return; }
   let rel = decodeURIComponent(url.pathname);
   let root = webroot;

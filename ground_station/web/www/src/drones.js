@@ -16,8 +16,11 @@ const ROTOR_ANGLE = [-45, 135, 45, -135].map((d) => (d * Math.PI) / 180);
 const ROTOR_SPIN = [1, 1, -1, -1];   // +1: counter-clockwise seen from above
 export const SPIN_SCALE = 0.045;     // drawn rad/s per real rad/s (500 rad/s -> ~3.6 turns/s)
 
-const TRAIL_SLOTS = 480;             // per drone
-const TRAIL_DT = 0.25;               // s of sim time between trail points
+// Trails: at most TRAIL_BUDGET segments in all (every one costs vertex work
+// each frame), up to 480 points a drone, a point every 0.25 s of sim time or
+// more, so that a trail spans at least 60 s.
+const TRAIL_BUDGET = 16384;
+const TRAIL_MAX_SLOTS = 480;
 const TRAIL_LIFE = 120;              // s of sim time a trail point stays visible
 const FLASH_MS = 900;
 
@@ -32,44 +35,109 @@ export function droneColour(id, out = new THREE.Color()) {
   return out.setHSL(((id * 0.381966) % 1 + 0.58) % 1, 0.78, 0.5);
 }
 
-function quadGeometries(arm) {
-  const g = {};
-  const bodyL = arm * 0.95, bodyW = arm * 0.62, bodyH = arm * 0.3;
-  // Body: a box with a small canopy; coloured per drone.
-  g.body = mergeGeometries([
-    new THREE.BoxGeometry(bodyL, bodyW, bodyH),
-    new THREE.SphereGeometry(bodyW * 0.42, 12, 8, 0, Math.PI * 2, 0, Math.PI / 2).scale(1.3, 1, 0.7).translate(0, 0, bodyH / 2),
-  ]);
-  // Frame: arms, motor pods, legs and a nose light, with vertex colours.
+// One instance per drone: on software GL (SwiftShader) each instance has a
+// fixed cost (about 25 us here), so the whole quadrotor (body, canopy, nose,
+// arms, motors, blades) is one geometry, and the rotors spin in the vertex
+// shader from a per-instance attribute of four angles. Low-poly (under 200
+// vertices) and lit per vertex: on software GL the vertex and pixel counts
+// are the cost, and flat faces under a directional and a hemisphere light
+// look the same lit per vertex as per pixel.
+// Vertex attributes: color (paint), bodyMask (1: takes the drone's instance
+// colour), rotor (k: spins with rotor k; -1: rigid).
+function quadGeometry(arm) {
   const parts = [];
-  const paint = (geo, hex) => {
-    const c = new THREE.Color(hex), n = geo.attributes.position.count, a = new Float32Array(3 * n);
-    for (let i = 0; i < n; i++) c.toArray(a, 3 * i);
-    geo.setAttribute('color', new THREE.BufferAttribute(a, 3));
-    return geo;
+  const add = (geo, hex, { body = 0, rotor = -1 } = {}) => {
+    geo.deleteAttribute('uv');
+    const n = geo.attributes.position.count, c = new THREE.Color(hex);
+    const col = new Float32Array(3 * n);
+    for (let i = 0; i < n; i++) c.toArray(col, 3 * i);
+    geo.setAttribute('color', new THREE.BufferAttribute(col, 3));
+    geo.setAttribute('bodyMask', new THREE.BufferAttribute(new Float32Array(n).fill(body), 1));
+    geo.setAttribute('rotor', new THREE.BufferAttribute(new Float32Array(n).fill(rotor), 1));
+    parts.push(geo);
   };
+  const bodyL = arm * 0.95, bodyW = arm * 0.62, bodyH = arm * 0.3;
+  add(new THREE.BoxGeometry(bodyL, bodyW, bodyH), 0xffffff, { body: 1 });
+  add(new THREE.SphereGeometry(bodyW * 0.42, 6, 2, 0, Math.PI * 2, 0, Math.PI / 2).scale(1.3, 1, 0.8).translate(0, 0, bodyH / 2), 0xdde3ea);
+  add(new THREE.BoxGeometry(arm * 0.12, arm * 0.22, arm * 0.12).translate(bodyL / 2, 0, 0), 0xff4d2e);  // nose: the front (body +x)
+  // Two straight arms: rotor 0 (-45 deg) to 1 (135), rotor 2 (45) to 3 (-135).
+  add(new THREE.BoxGeometry(2 * arm, arm * 0.09, arm * 0.07).rotateZ(ROTOR_ANGLE[0]), 0x2f333a);
+  add(new THREE.BoxGeometry(2 * arm, arm * 0.09, arm * 0.07).rotateZ(ROTOR_ANGLE[2]), 0x2f333a);
+  const rotorZ = arm * 0.17, prop = arm * 0.55;
   for (let k = 0; k < 4; k++) {
-    const a = ROTOR_ANGLE[k], cx = Math.cos(a) * arm, cy = Math.sin(a) * arm;
-    const armGeo = new THREE.BoxGeometry(arm, arm * 0.09, arm * 0.07).translate(arm / 2, 0, 0).rotateZ(a);
-    parts.push(paint(armGeo, k === 0 || k === 2 ? 0x3a3f47 : 0x2a2d33));
-    parts.push(paint(new THREE.CylinderGeometry(arm * 0.09, arm * 0.1, arm * 0.2, 12).rotateX(Math.PI / 2).translate(cx, cy, arm * 0.05), 0x1b1d21));
-    parts.push(paint(new THREE.CylinderGeometry(arm * 0.025, arm * 0.025, arm * 0.35, 6).rotateX(Math.PI / 2).translate(cx * 0.45, cy * 0.45, -arm * 0.2), 0x23262b));
+    const cx = Math.cos(ROTOR_ANGLE[k]) * arm, cy = Math.sin(ROTOR_ANGLE[k]) * arm;
+    add(new THREE.CylinderGeometry(arm * 0.07, arm * 0.1, arm * 0.24, 6, 1, true).rotateX(Math.PI / 2).translate(cx, cy, arm * 0.05), 0x1b1d21);
+    add(new THREE.PlaneGeometry(2 * prop, arm * 0.1).translate(cx, cy, rotorZ), k < 2 ? 0x0d0f12 : 0x2a2e35, { rotor: k });
   }
-  parts.push(paint(new THREE.SphereGeometry(arm * 0.07, 8, 6).translate(bodyL / 2, 0, 0), 0xff4d2e));
-  g.frame = mergeGeometries(parts);
-  // Rotor: two blades; and a translucent disc drawn while the motors turn.
-  const prop = arm * 0.55;
-  g.blade = new THREE.BoxGeometry(2 * prop, arm * 0.08, arm * 0.015);
-  g.disc = new THREE.CircleGeometry(prop * 1.02, 24);
-  g.rotorZ = arm * 0.17;
-  g.ring = new THREE.RingGeometry(arm * 2.0, arm * 2.5, 32);
-  g.blob = new THREE.CircleGeometry(arm * 1.15, 16);
-  return g;
+  return { geo: mergeGeometries(parts), rotorZ, prop, centres: ROTOR_ANGLE.map((a) => new THREE.Vector3(Math.cos(a) * arm, Math.sin(a) * arm, rotorZ)) };
+}
+
+// Per-vertex Lambert under the world's hemisphere and sun (same formula as
+// three's MeshLambertMaterial), the drone's colour on the body only, rotor spin.
+function quadMaterial(centres) {
+  return new THREE.ShaderMaterial({
+    vertexColors: true,
+    fog: true,
+    side: THREE.DoubleSide,
+    uniforms: THREE.UniformsUtils.merge([THREE.UniformsLib.fog, {
+      rotorCentre: { value: centres },
+      uSunDir: { value: new THREE.Vector3(0, 0, 1) },
+      uSun: { value: new THREE.Color(1, 1, 1) },
+      uSky: { value: new THREE.Color(1, 1, 1) },
+      uGround: { value: new THREE.Color(0.3, 0.3, 0.3) },
+      uUp: { value: new THREE.Vector3(0, 0, 1) },
+    }]),
+    vertexShader: `
+      #include <common>
+      #include <fog_pars_vertex>
+      attribute float bodyMask;
+      attribute float rotor;
+      attribute vec4 rotorPhase;
+      uniform vec3 rotorCentre[4];
+      uniform vec3 uSunDir, uSun, uSky, uGround, uUp;
+      varying vec3 vLit;
+      void main() {
+        vec3 p = position;
+        if (rotor > -0.5) {
+          int k = int(rotor + 0.5);
+          float a = rotorPhase[k];
+          vec2 c = rotorCentre[k].xy, d = p.xy - c;
+          p.xy = c + vec2(cos(a) * d.x - sin(a) * d.y, sin(a) * d.x + cos(a) * d.y);
+        }
+        mat4 m = modelMatrix * instanceMatrix;
+        vec3 n = normalize(mat3(m) * normal);
+        vec3 base = color;
+        #ifdef USE_INSTANCING_COLOR
+          base *= mix(vec3(1.0), instanceColor, bodyMask);
+        #endif
+        vec3 irradiance = mix(uGround, uSky, 0.5 * dot(n, uUp) + 0.5) + uSun * max(dot(n, uSunDir), 0.0);
+        vLit = base * irradiance * RECIPROCAL_PI;
+        vec4 mvPosition = viewMatrix * m * vec4(p, 1.0);
+        gl_Position = projectionMatrix * mvPosition;
+        #include <fog_vertex>
+      }`,
+    fragmentShader: `
+      #include <common>
+      #include <fog_pars_fragment>
+      varying vec3 vLit;
+      void main() {
+        gl_FragColor = vec4(vLit, 1.0);
+        #include <tonemapping_fragment>
+        #include <colorspace_fragment>
+        #include <fog_fragment>
+      }`,
+  });
+}
+
+function discsGeometry(centres, prop) {
+  return mergeGeometries(centres.map((c) => new THREE.CircleGeometry(prop * 1.02, 12).translate(c.x, c.y, c.z + 0.002)));
 }
 
 export class Drones {
-  constructor(scene) {
+  constructor(scene, { sun, hemi } = {}) {
     this.scene = scene;
+    this.sun = sun;
+    this.hemi = hemi;
     this.group = new THREE.Group();
     scene.add(this.group);
     this.n = 0;
@@ -88,7 +156,7 @@ export class Drones {
     this.n = n;
     this.arm = arm > 0 ? arm : 0.2275;
     this.sensorCount = Math.max(0, Math.min(64, sensorCount | 0));
-    const g = quadGeometries(this.arm);
+    const g = quadGeometry(this.arm);
     const mk = (geo, mat, count, shadow = true) => {
       const m = new THREE.InstancedMesh(geo, mat, count);
       m.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
@@ -98,18 +166,18 @@ export class Drones {
       this.group.add(m);
       return m;
     };
-    this.body = mk(g.body, surface({ color: 0xffffff, roughness: 0.45, metalness: 0.1 }), n);
-    this.body.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
-    this.frame = mk(g.frame, surface({ vertexColors: true, roughness: 0.6, metalness: 0.2 }), n);
-    this.blades = mk(g.blade, surface({ color: 0x15171a, roughness: 0.4 }), 4 * n);
-    this.discs = mk(g.disc, new THREE.MeshBasicMaterial({ color: 0xcfd6de, transparent: true, opacity: 0.22, depthWrite: false, side: THREE.DoubleSide }), 4 * n, false);
-    this.rings = mk(g.ring, new THREE.MeshBasicMaterial({ color: 0xffffff, transparent: true, opacity: 0.9, depthWrite: false, side: THREE.DoubleSide }), n, false);
+    this.phase = new THREE.InstancedBufferAttribute(new Float32Array(4 * n), 4).setUsage(THREE.DynamicDrawUsage);
+    g.geo.setAttribute('rotorPhase', this.phase);
+    this.quads = mk(g.geo, quadMaterial(g.centres), n);
+    this.quads.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
+    // Blur discs while the motors turn (not at quality low: one more instance a drone).
+    this.discs = mk(discsGeometry(g.centres, g.prop), new THREE.MeshBasicMaterial({ color: 0xcfd6de, transparent: true, opacity: 0.22, depthWrite: false, side: THREE.DoubleSide }), n, false);
+    this.discs.visible = !this.blobShadows;
+    this.rings = mk(new THREE.RingGeometry(this.arm * 2.0, this.arm * 2.5, 24), new THREE.MeshBasicMaterial({ color: 0xffffff, transparent: true, opacity: 0.9, depthWrite: false, side: THREE.DoubleSide }), n, false);
     this.rings.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
     // Blob shadows, for when the world has no shadow maps (quality low).
-    this.blobs = mk(g.blob, new THREE.MeshBasicMaterial({ color: 0x000000, transparent: true, opacity: 0.22, depthWrite: false }), n, false);
+    this.blobs = mk(new THREE.CircleGeometry(this.arm * 1.15, 10), new THREE.MeshBasicMaterial({ color: 0x000000, transparent: true, opacity: 0.22, depthWrite: false }), n, false);
     this.blobs.visible = this.blobShadows;
-    this.rotorZ = g.rotorZ;
-    this.rotorPos = ROTOR_ANGLE.map((a) => new THREE.Vector3(Math.cos(a) * this.arm, Math.sin(a) * this.arm, g.rotorZ));
 
     this.pos = new Float64Array(3 * n);       // as rendered
     this.quat = new Float32Array(4 * n);
@@ -125,7 +193,10 @@ export class Drones {
     this.liveMask = new Uint8Array(n);
 
     // Trails: slot k of drone i is segment (k * n + i): two vertices.
-    const tv = TRAIL_SLOTS * n * 2;
+    this.trailSlots = Math.max(32, Math.min(TRAIL_MAX_SLOTS, Math.floor(TRAIL_BUDGET / n)));
+    this.trailDt = Math.max(0.25, 60 / this.trailSlots);
+    this.trailFilled = 0;
+    const tv = this.trailSlots * n * 2;
     const tg = new THREE.BufferGeometry();
     tg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * tv), 3).setUsage(THREE.DynamicDrawUsage));
     tg.setAttribute('tcolor', new THREE.BufferAttribute(new Float32Array(3 * tv), 3).setUsage(THREE.DynamicDrawUsage));
@@ -140,6 +211,7 @@ export class Drones {
         void main() { if (vA <= 0.0) discard; gl_FragColor = vec4(vC, 0.25 + 0.65 * vA); }`,
       transparent: true, depthWrite: false,
     });
+    tg.setDrawRange(0, 0);
     this.trails = new THREE.LineSegments(tg, this.trailMat);
     this.trails.frustumCulled = false;
     this.trails.visible = this.showTrails;
@@ -173,10 +245,15 @@ export class Drones {
 
   clearTrails() {
     if (!this.n) return;
-    this.trails.geometry.attributes.stamp.array.fill(-1e9);
-    this.trails.geometry.attributes.stamp.needsUpdate = true;
+    const st = this.trails.geometry.attributes.stamp;
+    st.array.fill(-1e9);
+    st.clearUpdateRanges();
+    st.needsUpdate = true;
     this.trailHasLast.fill(0);
     this.trailT = -Infinity;
+    this.trailSlot = 0;
+    this.trailFilled = 0;
+    this.trails.geometry.setDrawRange(0, 0);
   }
 
   // Applies a `frame` message: positions, attitude, rotor speeds, flags.
@@ -203,7 +280,7 @@ export class Drones {
     const t = f.t;
     if (Number.isFinite(t)) {
       if (t < this.trailT - 1e-6) this.clearTrails();   // the clock went back: a seek or a new run
-      if (t - this.trailT >= TRAIL_DT) this.addTrailPoint(t);
+      if (t - this.trailT >= this.trailDt) this.addTrailPoint(t);
       this.trailMat.uniforms.uNow.value = t;
     }
     if (this.showRays && Array.isArray(f.rays)) this.applyRays(f.rays);
@@ -239,8 +316,10 @@ export class Drones {
       a.addUpdateRange(2 * slot * n * size, 2 * n * size);
       a.needsUpdate = true;
     }
-    this.trailSlot = (slot + 1) % TRAIL_SLOTS;
+    this.trailSlot = (slot + 1) % this.trailSlots;
     this.trailT = t;
+    this.trailFilled = Math.min(this.trailSlots, this.trailFilled + 1);
+    this.trails.geometry.setDrawRange(0, this.trailFilled * n * 2);
   }
 
   applyRays(rays) {
@@ -275,10 +354,12 @@ export class Drones {
     if (this.rays) this.rays.visible = on;
   }
 
+  // Quality low: blob shadows instead of shadow maps, no blur discs.
   setBlobShadows(on) {
     this.blobShadows = on;
     if (this.blobs) this.blobs.visible = on;
-    for (const m of [this.body, this.frame, this.blades]) if (m) m.castShadow = !on;
+    if (this.discs) this.discs.visible = !on;
+    if (this.quads) this.quads.castShadow = !on;
   }
 
   setTrails(on) {
@@ -307,26 +388,21 @@ export class Drones {
     if (!n) return;
     const { m, r, q, p, s, c } = this.tmp;
     const sc = this.scale;
-    let k4 = 0, b = 0;
+    let b = 0, ringN = 0, discN = 0;
+    const P = this.phase.array;
     for (let i = 0; i < n; i++) {
       if (!this.present[i]) continue;
       p.set(this.pos[3 * i], this.pos[3 * i + 1], this.pos[3 * i + 2]);
       q.set(this.quat[4 * i], this.quat[4 * i + 1], this.quat[4 * i + 2], this.quat[4 * i + 3]);
       if (q.lengthSq() < 1e-12) q.identity(); else q.normalize();
       m.compose(p, q, s.set(sc, sc, sc));
-      this.body.setMatrixAt(b, m);
-      this.frame.setMatrixAt(b, m);
-      const motors = (this.flags[i] & FLAG.MOTORS_ON) !== 0 || this.w[4 * i] > 1;
+      this.quads.setMatrixAt(b, m);
       for (let k = 0; k < 4; k++) {
         const j = 4 * i + k;
         this.angle[j] = (this.angle[j] + ROTOR_SPIN[k] * this.w[j] * SPIN_SCALE * dt) % (2 * Math.PI);
-        r.makeRotationZ(this.angle[j]).setPosition(this.rotorPos[k]);
-        this.blades.setMatrixAt(k4, r.premultiply(m));
-        if (motors) r.makeTranslation(this.rotorPos[k].x, this.rotorPos[k].y, this.rotorZ + 0.001);
-        else r.makeScale(0, 0, 0);
-        this.discs.setMatrixAt(k4, r.premultiply(m));
-        k4++;
+        P[4 * b + k] = this.angle[j];
       }
+      if ((this.flags[i] & FLAG.MOTORS_ON) !== 0 || this.w[4 * i] > 1) this.discs.setMatrixAt(discN++, m);
       // Body colour: collision flash over failsafe / lost over the drone's own.
       const flags = this.flags[i];
       const mark = flags & FLAG.FAILSAFE ? COL_FAILSAFE : this.isLost(i) ? COL_LOST : null;
@@ -336,16 +412,15 @@ export class Drones {
         const f = left / FLASH_MS, pulse = 0.5 + 0.5 * Math.cos((1 - f) * Math.PI * 6);
         c.lerp(COL_FLASH, Math.min(1, 1.2 * f)).lerp(COL_WHITE, 0.35 * pulse * f);
       }
-      this.body.setColorAt(b, c);
-      // Ring under marked or selected drones.
+      this.quads.setColorAt(b, c);
+      // Ring under marked or selected drones (only those are drawn).
       if (mark || i === this.selected || left > 0) {
         const ringColour = left > 0 ? COL_FLASH : mark ?? COL_SELECT;
         r.makeTranslation(p.x, p.y, p.z - this.arm * 0.5 * sc);
         r.scale(s.set(sc, sc, sc));
-        this.rings.setMatrixAt(b, r);
-        this.rings.setColorAt(b, ringColour);
-      } else {
-        this.rings.setMatrixAt(b, r.makeScale(0, 0, 0));
+        this.rings.setMatrixAt(ringN, r);
+        this.rings.setColorAt(ringN, ringColour);
+        ringN++;
       }
       if (this.blobShadows) {
         const k = sc * Math.max(0.35, 1 - (p.z - this.groundZ) / 25);
@@ -354,10 +429,22 @@ export class Drones {
       }
       b++;
     }
-    for (const mesh of [this.body, this.frame, this.rings, this.blobs]) mesh.count = b;
-    for (const mesh of [this.blades, this.discs]) mesh.count = 4 * b;
-    for (const mesh of [this.body, this.frame, this.blades, this.discs, this.rings, this.blobs]) mesh.instanceMatrix.needsUpdate = true;
-    this.body.instanceColor.needsUpdate = true;
+    this.quads.count = this.blobs.count = b;
+    this.rings.count = ringN;
+    this.discs.count = discN;
+    for (const mesh of [this.quads, this.discs, this.rings, this.blobs]) mesh.instanceMatrix.needsUpdate = true;
+    this.phase.needsUpdate = true;
+    const u = this.quads.material.uniforms;
+    if (this.sun) {
+      u.uSunDir.value.subVectors(this.sun.position, this.sun.target.position).normalize();
+      u.uSun.value.copy(this.sun.color).multiplyScalar(this.sun.intensity);
+    }
+    if (this.hemi) {
+      u.uSky.value.copy(this.hemi.color).multiplyScalar(this.hemi.intensity);
+      u.uGround.value.copy(this.hemi.groundColor).multiplyScalar(this.hemi.intensity);
+      u.uUp.value.copy(this.hemi.position).normalize();
+    }
+    this.quads.instanceColor.needsUpdate = true;
     this.rings.instanceColor.needsUpdate = true;
   }
 

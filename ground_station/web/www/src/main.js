@@ -13,14 +13,14 @@ const fpsWanted = Math.max(1, Math.min(60, Number(params.get('fps')) || 30));
 
 // ?quality=high|medium|low fixes the quality; the default adapts (world.js).
 const world = new World(document.getElementById('view'), { quality: params.get('quality') ?? 'auto' });
-const drones = new Drones(world.scene);
+const drones = new Drones(world.scene, { sun: world.sun, hemi: world.hemi });
 const panel = new Panel({ onSelect: (i) => { drones.selected = i; if (i >= 0) document.getElementById('i-leader').value = i; } });
 const conn = new Connection(wsUrl, { fps: fpsWanted, rays: false });
 const controls = new Controls(conn, panel);
 
 const state = {
   scene: null, frame: null, frameNew: false, frames: 0, status: null, task: null,
-  source: 'live', recording: null, framed: false, fps: 0, renderMs: 0, errors: [],
+  source: 'live', recording: null, framed: false, fps: 0, renderMs: 0, errors: [], drawn: 0,
 };
 
 conn.on('state', (s) => {
@@ -67,13 +67,21 @@ conn.on('task', (t) => {
   panel.setTask(t, state.frame?.t);
   if (t.state !== prev && t.state !== 'none') panel.log(`task ${t.state}${t.phase && t.phase !== t.state ? ` (${t.phase})` : ''}${t.reason ? `: ${t.reason}` : ''}`, t.state === 'failed' ? 'bad' : 'info');
 });
+// Collisions flash at once; the log gets at most one line a second.
+const pendingHits = [];
 conn.on('collision', (c) => {
   const now = performance.now();
   drones.flash(c.drone, now);
   if (c.kind === 'drone' && Number.isInteger(c.other)) drones.flash(c.other, now);
   panel.markHit(c.drone, now);
-  panel.log(`collision: drone ${c.drone} with ${c.kind === 'drone' ? `drone ${c.other}` : c.kind} at t=${Number(c.t).toFixed(2)} s`, 'bad');
+  pendingHits.push(`drone ${c.drone} with ${c.kind === 'drone' ? `drone ${c.other}` : c.kind} at t=${Number(c.t).toFixed(2)} s`);
 });
+setInterval(() => {
+  if (!pendingHits.length) return;
+  const more = pendingHits.length > 3 ? ` and ${pendingHits.length - 3} more` : '';
+  panel.log(`collision: ${pendingHits.slice(0, 3).join('; ')}${more}`, 'bad');
+  pendingHits.length = 0;
+}, 1000);
 conn.on('ack', (a) => controls.onAck(a));
 conn.on('replay', (r) => {
   state.recording = r.name ?? state.recording;
@@ -156,6 +164,7 @@ function loop(now) {
   world.render();
   renderSum += performance.now() - t0;
   fpsCount++;
+  state.drawn++;
   if (now - fpsSince >= 1000) {
     state.fps = (fpsCount * 1000) / (now - fpsSince);
     state.renderMs = renderSum / fpsCount;
@@ -179,10 +188,12 @@ window.ddswarm = {
   get droneCount() { return drones.count; },
   get drones() { return drones.snapshot(); },
   get fps() { return state.fps; },
+  get drawn() { return state.drawn; },
   get renderMs() { return state.renderMs; },
   get lastAck() { return controls.lastAck; },
   get source() { return state.source; },
   get frames() { return state.frames; },
+  get messages() { return conn.received; },
   get tick() { return state.frame?.tick ?? null; },
   get t() { return state.frame?.t ?? null; },
   get scene() { return state.scene; },
@@ -197,3 +208,5 @@ window.ddswarm = {
   setCamera,
   upload: (file) => controls.upload(file),
 };
+// For profiling in the browser's console; not an interface.
+Object.defineProperty(window.ddswarm, '_internals', { value: { world, drones, panel, conn, controls } });

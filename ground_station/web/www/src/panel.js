@@ -105,10 +105,17 @@ export class Panel {
     this.hit.set(id, nowMs + 1500);
   }
 
-  // Refreshes the table from the latest frame (call a few times a second).
+  // Refreshes the table from the latest frame (call a few times a second):
+  // only the rows in view (with a margin), as layout is what costs.
   updateTable(frame, isLost, nowMs) {
     if (!frame) return;
-    for (const d of frame.drones ?? []) {
+    const wrap = this.el.body.closest('.tablewrap');
+    const rowH = this.rows[0]?.tr.offsetHeight || 20;
+    const first = Math.max(0, Math.floor(wrap.scrollTop / rowH) - 5);
+    const last = first + Math.ceil(wrap.clientHeight / rowH) + 10;
+    const drones = frame.drones ?? [];
+    for (let k = first; k <= last && k < drones.length; k++) {
+      const d = drones[k];
       const row = this.rows[d?.id];
       if (!row) continue;
       const c = row.cells;

@@ -22,7 +22,10 @@ export function surface({ roughness, metalness, ...p }) {
 // and steps down while the page draws fewer than 27 frames a second.
 //   high:   multisampling (when the context has it), soft shadow maps, full pixel ratio
 //   medium: hard shadow maps (one tap), pixel ratio 1
-//   low:    no shadow maps (blob shadows under the drones), unlit ground, pixel ratio 0.75
+//   low:    no shadow maps (blob shadows under the drones), pixel ratio 0.75, and
+//           no ground plane: the ground is the clear colour and only the sky
+//           above the horizon is drawn (a full-screen plane is the costliest
+//           thing on software GL)
 export const QUALITY = ['high', 'medium', 'low'];
 
 export function softwareGL() {
@@ -60,6 +63,7 @@ export class World {
     const hemi = new THREE.HemisphereLight(0xe8f2ff, 0x55604a, 1.6);
     hemi.position.set(0, 0, 1);
     scene.add(hemi);
+    this.hemi = hemi;
     const sun = new THREE.DirectionalLight(0xfff1dc, 2.6);
     sun.castShadow = true;
     sun.shadow.mapSize.set(2048, 2048);
@@ -68,7 +72,10 @@ export class World {
     scene.add(sun, sun.target);
     this.sun = sun;
     this.groundLit = surface({ color: 0x8fa38a, roughness: 0.95 });
-    this.groundFlat = new THREE.MeshBasicMaterial({ color: 0x9fb39a, toneMapped: false });
+    this.groundColour = new THREE.Color(0x9fb39a);
+    this.skyColour = new THREE.Color(0xc9dbe8);
+    this.sky = skyDome(this.skyColour, this.groundColour);
+    scene.add(this.sky);
     this.quality = start;
 
     // Perspective camera for orbit and follow.
@@ -109,7 +116,9 @@ export class World {
     r.shadowMap.enabled = q !== 'low';
     r.shadowMap.type = q === 'high' ? THREE.PCFShadowMap : THREE.BasicShadowMap;
     r.shadowMap.needsUpdate = true;
-    if (this.ground) this.ground.material = q === 'low' ? this.groundFlat : this.groundLit;
+    if (this.ground) this.ground.visible = q !== 'low';
+    this.sky.visible = q === 'low';
+    this.scene.background = q === 'low' ? this.groundColour : this.skyColour;
     this.scene.traverse((o) => { if (o.material) [].concat(o.material).forEach((m) => { m.needsUpdate = true; }); });
     this.resize();
     this.onQuality?.(q);
@@ -154,8 +163,8 @@ export class World {
 
     // Ground: a plane beyond the bounds, with a 5 m grid over the bounds.
     const margin = Math.max(60, 0.5 * Math.max(size.x, size.y));
-    const ground = new THREE.Mesh(new THREE.PlaneGeometry(size.x + 2 * margin, size.y + 2 * margin),
-      this.quality === 'low' ? this.groundFlat : this.groundLit);
+    const ground = new THREE.Mesh(new THREE.PlaneGeometry(size.x + 2 * margin, size.y + 2 * margin), this.groundLit);
+    ground.visible = this.quality !== 'low';
     this.ground = ground;
     ground.position.set(centre.x, centre.y, z0);
     ground.receiveShadow = true;
@@ -294,8 +303,31 @@ export class World {
   }
 
   render() {
-    this.renderer.render(this.scene, this.activeCamera);
+    const cam = this.activeCamera;
+    this.sky.position.copy(cam.position);
+    this.renderer.render(this.scene, cam);
   }
+}
+
+// The sky above the horizon (and a band below it fading to the ground
+// colour), as a cap of a sphere around the camera: drawn first, behind
+// everything, covering only the pixels where sky shows.
+function skyDome(sky, ground) {
+  const geo = new THREE.SphereGeometry(900, 24, 12, 0, Math.PI * 2, 0, Math.PI * 0.56).rotateX(Math.PI / 2);
+  const pos = geo.attributes.position, col = new Float32Array(3 * pos.count);
+  const haze = sky.clone().lerp(new THREE.Color(0xffffff), 0.25), c = new THREE.Color();
+  for (let i = 0; i < pos.count; i++) {
+    const el = Math.asin(Math.max(-1, Math.min(1, pos.getZ(i) / 900)));  // elevation, rad
+    if (el < 0) c.copy(haze).lerp(ground, Math.min(1, -el / (Math.PI * 0.06)));
+    else c.copy(haze).lerp(sky, Math.min(1, el / 0.35));
+    c.toArray(col, 3 * i);
+  }
+  geo.setAttribute('color', new THREE.BufferAttribute(col, 3));
+  const m = new THREE.Mesh(geo, new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.BackSide, depthWrite: false, depthTest: false, fog: false, toneMapped: false }));
+  m.renderOrder = -10;
+  m.frustumCulled = false;
+  m.visible = false;
+  return m;
 }
 
 function chequerTexture() {

@@ -1,0 +1,42 @@
+// Frame rate of the web view in headless Chromium (SwiftShader WebGL): opens
+// the page at each quality level and prints the page's own frame count.
+// A measurement to report, never a pass/fail threshold.
+//
+//   node tests/web/fps.mjs --url http://127.0.0.1:PORT/ [--seconds 10] [--quality auto|high|medium|low|all]
+//        [--width 1280 --height 720] [--shot DIR] [--cam orbit|follow|top]
+import path from 'node:path';
+import fs from 'node:fs';
+import { launch, openPage, waitFor, measureFps, parseArgs } from './browser.mjs';
+
+const a = parseArgs(process.argv.slice(2));
+const seconds = Number(a.seconds ?? 10);
+const levels = (a.quality ?? 'all') === 'all' ? ['high', 'medium', 'low', 'auto'] : [a.quality];
+const width = Number(a.width ?? 1280), height = Number(a.height ?? 720);
+const browser = await launch();
+let rc = 0;
+try {
+  for (const q of levels) {
+    const u = new URL(a.url);
+    u.searchParams.set('quality', q);
+    if (a.cam) u.searchParams.set('cam', a.cam);
+    const page = await openPage(browser, u.href, { width, height });
+    await waitFor(page, () => window.ddswarm.connected && window.ddswarm.droneCount > 0, null, { what: 'drones drawn' });
+    if (a.cam) await page.evaluate((c) => window.ddswarm.setCamera(c), a.cam);
+    await page.waitForTimeout(q === 'auto' ? 8000 : 3000);  // warm up (auto: let it settle)
+    const f = await measureFps(page, seconds);
+    const info = await page.evaluate(() => ({ n: window.ddswarm.droneCount, q: window.ddswarm.quality, ms: window.ddswarm.renderMs, gl: window.ddswarm.gl }));
+    console.log(`fps ${q.padEnd(6)} ${f.mean.toFixed(1)} (min ${f.min.toFixed(1)}, max ${f.max.toFixed(1)}) over ${seconds} s: ${info.n} drones, ` +
+      `${width}x${height} viewport, drawing at ${info.q}, ${info.ms.toFixed(1)} ms main-thread per frame; ${info.gl}`);
+    if (a.shot) {
+      fs.mkdirSync(a.shot, { recursive: true });
+      const p = path.resolve(a.shot, `web_fps_${q}.png`);
+      await page.screenshot({ path: p });
+      console.log(`screenshot: ${p}`);
+    }
+    if (page.problems.length) { console.log(`page problems: ${page.problems.join('; ')}`); rc = 1; }
+    await page.close();
+  }
+} finally {
+  await browser.close();
+}
+process.exit(rc);
