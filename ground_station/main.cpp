@@ -5,9 +5,11 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 
 #include "common/cli_checks.hpp"
+#include "common/config_error.hpp"
 #include "common/process.hpp"
 #include "ground_station/dds_commander.hpp"
 #include "ground_station/experiment.hpp"
@@ -16,6 +18,7 @@
 #include "ground_station/menu.hpp"
 #include "ground_station/report.hpp"
 #include "ground_station/trace.hpp"
+#include "ground_station/web/web_bridge.hpp"
 
 using namespace ddswarm;
 using namespace ddswarm::gs;
@@ -46,6 +49,29 @@ void append_result(const std::string& csv, const TaskOutcome& o, int drones) {
   append_csv(csv, rec);
 }
 
+/// `--web`: serves the live view until SIGINT/SIGTERM (docs/web_view.md).
+int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root, bool remote,
+              double upload_mb, double duration_s) {
+  web::WebBridgeOptions o;
+  web::parse_listen_address(addr, o.server);
+  o.server.web_root = root.empty() ? web::default_web_root() : std::filesystem::path(root);
+  o.server.allow_remote = remote;
+  check_range("--web-max-upload-mb", upload_mb, 1.0, 1048576.0);
+  o.server.max_upload_bytes = static_cast<std::uint64_t>(upload_mb * (1 << 20));
+  check_non_negative("--web-duration", duration_s);
+  o.server.validate();
+  o.gs = file.gs;
+  o.task = file.task;
+  o.dds = file.dds;
+  o.duration_s = duration_s;
+  web::WebBridge bridge(o);
+  std::printf("web: serving %s\n", bridge.url().c_str());
+  std::fflush(stdout);
+  auto counts = bridge.run();
+  std::fprintf(stderr, "%s\n", counts.line().c_str());
+  return 0;
+}
+
 bool finite_all(std::initializer_list<double> v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
@@ -62,6 +88,15 @@ int main(int argc, char** argv) {
     DdsConfig dds_cli;
     app.add_option("--config", config, "scenario YAML (ground_station, task and dds sections)");
     add_dds_options(app, dds_cli);
+    std::string web_addr, web_root;
+    bool web_remote = false;
+    double web_upload_mb = 512, web_duration = 0;
+    app.add_option("--web", web_addr,
+                   "serve the live 3D view at ADDR:PORT (e.g. 127.0.0.1:8080; port 0 = any free one) until Ctrl-C");
+    app.add_option("--web-root", web_root, "the page's files (default: the source tree's ground_station/web/www)");
+    app.add_flag("--web-allow-remote", web_remote, "allow --web on a non-loopback address (the page commands the swarm)");
+    app.add_option("--web-max-upload-mb", web_upload_mb, "largest recording the page may upload (MiB)");
+    app.add_option("--web-duration", web_duration, "with --web: stop after this many wall seconds (0 = until Ctrl-C)");
 
     auto* menu = app.add_subcommand("menu", "interactive console (the default)");
     auto* wait_agents = app.add_subcommand("wait-agents", "wait until the server and N agents are online");
@@ -139,6 +174,10 @@ int main(int argc, char** argv) {
     file.dds.validate();
     install_stop_signals();
 
+    if (!web_addr.empty()) {
+      if (!app.get_subcommands().empty()) throw FieldError("--web", web_addr, "takes no subcommand");
+      return serve_web(file, web_addr, web_root, web_remote, web_upload_mb, web_duration);
+    }
     if (*experiment) {
       auto exp = load_experiment_file(exp_file);
       ExperimentOptions opt;
@@ -183,6 +222,7 @@ int main(int argc, char** argv) {
       return ok ? 0 : 1;
     }
     if (*status) {
+      gs.wait_task_status(0.5);  // latched: arrives right after the status when there is one
       const SwarmStatus st = gs.status();
       std::printf("%s\n%s\n", format_status(st).c_str(), format_rejections(st).c_str());
       if (status_drones) {
