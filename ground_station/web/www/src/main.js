@@ -36,7 +36,13 @@ conn.on('hello', (m) => {
   state.source = m.source ?? 'live';
   panel.setSource(state.source, state.recording);
   controls.setSource(state.source);
-  if (changed) { drones.clearTrails(); state.framed = false; }
+  if (changed) {
+    drones.clearTrails();
+    state.framed = false;
+    state.status = null;
+    drones.setLive(null);  // a recording's liveness is in its frames' flags
+    if (state.source === 'replay') setCamera('follow');
+  }
   if (m.gs_name) document.title = `ddswarm · ${m.gs_name}`;
 });
 conn.on('scene', (s) => {
@@ -92,6 +98,21 @@ conn.on('error', (e) => {
   state.errors.push(e.message);
   panel.log(`bridge: ${e.message}`, 'bad');
 });
+
+// A recording has no live status: the panel shows what its frames say.
+function statusOfFrame(f) {
+  const ds = f.drones ?? [];
+  const col = [0, 0, 0];
+  let air = 0, live = 0, fs = 0;
+  for (const d of ds) {
+    if (d.flags & 1) air++;
+    if (d.flags & 2) fs++;
+    if (d.flags & 4) live++;
+    if (Array.isArray(d.col)) for (let k = 0; k < 3; k++) col[k] += d.col[k] | 0;
+  }
+  const r = controls.replay;
+  return { mode: 'replay', state: r ? (r.playing ? `playing ×${r.rate}` : 'paused') : '', rtf: null, agents_live: live, num_drones: ds.length, airborne: air, failsafe: fs, collisions: col };
+}
 
 function colourTable() {
   panel.rows.forEach((row, i) => {
@@ -157,6 +178,7 @@ function loop(now) {
   if (now - tableAt > 250) {
     tableAt = now;
     panel.updateTable(state.frame, (i) => drones.isLost(i), now);
+    if (state.source === 'replay' && state.frame) panel.setStatus(statusOfFrame(state.frame));
   }
   drones.update(dt, now);
   world.update(dt, world.mode === 'follow' ? drones.centroid() : null);
