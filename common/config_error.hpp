@@ -22,10 +22,33 @@ class FieldError : public std::runtime_error {
   std::string field_;
 };
 
-/// A configuration file could not be used. what() is "file:line: message".
+/// `text` with control characters escaped (\n, \t, \xNN), so a message
+/// that quotes a key or value from a file stays on one line.
+inline std::string one_line(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (unsigned char c : text) {
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (c < 0x20 || c == 0x7f) {
+      const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out;
+}
+
+/// A configuration file could not be used. what() is "file:line: message",
+/// always one line (control characters quoted from the file are escaped).
 class ConfigError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit ConfigError(const std::string& what) : std::runtime_error(one_line(what)) {}
 };
 
 template <class T>

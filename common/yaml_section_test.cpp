@@ -57,6 +57,11 @@ TEST(YamlSection, SyntaxErrorAndMissingFile) {
   EXPECT_THROW(YamlDocument::load_file("/nonexistent/file.yaml"), ConfigError);
 }
 
+// Found by fuzz_config: a quoted key holding a newline made a two-line error.
+TEST(YamlSection, ErrorsStayOnOneLineWhateverTheFileHolds) {
+  EXPECT_EQ(error_of("demo:\n  \"rad\\nius\\t\\x01\": 2\n"), "x.yaml:2: demo.rad\\nius\\t\\x01: unknown key");
+}
+
 TEST(YamlSection, DuplicateKeyIsAnError) {
   EXPECT_EQ(error_of("demo:\n  radius_m: 2\n  radius_m: 3\n"),
             "x.yaml:3: demo.radius_m: duplicate key (first at line 2)");
