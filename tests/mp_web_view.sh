@@ -5,7 +5,8 @@
 # drones as fly, at their DDS positions within 0.1 m, that its Take off button
 # gets the swarm airborne by the DDS state, that the bridge survives a
 # browser leaving mid-stream and malformed messages, and saves screenshots
-# (paths printed). Then the page's frame rate with 128 drones from the mock
+# (paths printed); tests/web/replay_test.mjs plays the run's recording in the
+# page. Then the page's frame rate with 128 drones from the mock
 # bridge is printed: a measurement, not an assertion.
 source "$(dirname "$0")/lib.sh"
 N=4
@@ -31,10 +32,18 @@ done
 [ -n "$url" ] || fail "ddswarm-gs --web printed no URL"
 echo "bridge at $url"
 timeout 60 "$BIN/ddswarm-gs" --config "$CONFIG" --domain "$DOMAIN" wait-agents --count "$N" || fail "agents did not come online"
+# The run is recorded, for the page's recording player afterwards.
+start rec "$BIN/ddswarm-record" -o "$WORK/run.mcap" --domain "$DOMAIN" \
+  --topics ddswarm/swarm_state,ddswarm/scene,ddswarm/task,ddswarm/collision
+sleep 1
 
 timeout 300 node "$SRC/tests/web/view_test.mjs" --url "$url" --drones "$N" --out "$ARTIFACTS" \
   --gs "$BIN/ddswarm-gs" --domain "$DOMAIN" --config "$CONFIG" || fail "browser test failed"
 kill -0 "$PID_web" 2>/dev/null || fail "the bridge died"
+kill -INT "$PID_rec"; wait_pid "$PID_rec" 20 || fail "the recorder did not stop"
+ls -l "$WORK/run.mcap"
+timeout 180 node "$SRC/tests/web/replay_test.mjs" --url "$url" --recording "$WORK/run.mcap" --drones "$N" --out "$ARTIFACTS" \
+  || fail "recording player test failed"
 
 # The frame rate with 128 drones (mock bridge: the page's cost alone).
 start mock node "$SRC/ground_station/web/www/dev/mock_bridge.mjs" --port 0 --drones 128 --start task

@@ -36,7 +36,7 @@ export async function waitFor(page, fn, arg, { timeout = 30000, what = 'conditio
   while (Date.now() < end) {
     last = await page.evaluate(fn, arg);
     if (last) return last;
-    await new Promise((r) => setTimeout(r, 200));
+    await new Promise((r) => setTimeout(r, 100));
   }
   throw new Error(`timed out after ${timeout / 1000} s waiting for ${what} (last: ${JSON.stringify(last)})`);
 }

@@ -350,7 +350,7 @@ const server = http.createServer((req, res) => {
       res.setHeader('Content-Type', 'application/json');
       if (size > 64 << 20) { res.statusCode = 400; res.end(JSON.stringify({ error: `recording of ${size} bytes is over the mock's 64 MiB` })); return; }
       if (body.length < 8 || !body.subarray(0, 8).equals(magic)) { res.statusCode = 400; res.end(JSON.stringify({ error: 'not an MCAP file (no MCAP magic)' })); return; }
-      recording = makeRecording(String(req.headers['x-filename'] ?? 'upload.mcap'));
+      recording = makeRecording(url.searchParams.get('name') || 'recording.mcap');
       res.end(JSON.stringify({ id: recording.id, name: recording.name, duration: r3(recording.duration), frames: recording.frames.length }));
     });
     return;

@@ -126,7 +126,7 @@ export class Controls {
     st.textContent = `uploading ${file.name} (${(file.size / 1e6).toFixed(1)} MB)…`;
     this.panel.log(`opening recording ${file.name}`);
     try {
-      const res = await fetch('/api/recording', { method: 'POST', body: file, headers: { 'Content-Type': 'application/octet-stream', 'X-Filename': file.name } });
+      const res = await fetch(`/api/recording?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: file, headers: { 'Content-Type': 'application/octet-stream' } });
       let body = null;
       try { body = await res.json(); } catch { /* not JSON */ }
       if (!res.ok || !body?.id) throw new Error(body?.error ?? `HTTP ${res.status}`);

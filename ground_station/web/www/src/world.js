@@ -274,9 +274,9 @@ export class World {
 
   // Frames a group of points (e.g. the swarm) from behind (south), above.
   frame(centre, radius) {
-    const d = Math.max(16, radius * 2.8);
+    const d = Math.max(24, radius * 2.6);
     this.controls.target.copy(centre);
-    this.camera.position.set(centre.x - 0.3 * d, centre.y - d, centre.z + d * 0.6);
+    this.camera.position.set(centre.x - 0.35 * d, centre.y - d, centre.z + d * 0.95);
     this.controls.update();
   }
 
