@@ -495,7 +495,10 @@ struct WebBridge::Impl {
       try {
         rec = load_recording(file.string(), name);
       } catch (const std::exception& e) {
-        respond(400, nlohmann::json({{"error", name + ": " + e.what()}}).dump(-1, ' ', false,
+        std::string why = e.what();  // name the upload, not our temporary file
+        for (auto p = why.find(file.string()); p != std::string::npos; p = why.find(file.string()))
+          why.replace(p, file.string().size(), name);
+        respond(400, nlohmann::json({{"error", why}}).dump(-1, ' ', false,
                                                                               nlohmann::json::error_handler_t::replace));
         return;
       }
