@@ -64,6 +64,7 @@ struct Recorder::Impl {
   std::size_t max_queue = 0;
   std::map<std::uint16_t, std::string> channel_topic;
   std::map<std::string, std::uint64_t> written;
+  std::size_t not_written = 0;  // of a batch whose write failed
 
   static mcap::WriterOptions writer_options(const RecorderOptions& o) {
     mcap::WriterOptions w;
@@ -111,26 +112,57 @@ struct Recorder::Impl {
       std::lock_guard<std::mutex> lock(mu);
       batch.swap(queue);
     }
-    for (const auto& it : batch) {
-      writer.write(it.channel, it.log_ns, it.publish_ns, it.data.data(), it.data.size());
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const auto& it = batch[i];
+      try {
+        writer.write(it.channel, it.log_ns, it.publish_ns, it.data.data(), it.data.size());
+      } catch (...) {
+        not_written += batch.size() - i;
+        throw;
+      }
       ++written[channel_topic[it.channel]];
     }
     return !batch.empty();
   }
 
+  std::uint64_t total_written() const {
+    std::uint64_t n = 0;
+    for (const auto& [t, k] : written) n += k;
+    return n;
+  }
+
   RecorderCounts run(double duration_s) {
     const double end = duration_s > 0 ? wall_seconds() + duration_s : 1e300;
-    while (!stop_requested() && wall_seconds() < end) {
-      {
-        std::unique_lock<std::mutex> lock(mu);
-        cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty(); });
+    try {
+      while (!stop_requested() && wall_seconds() < end) {
+        {
+          std::unique_lock<std::mutex> lock(mu);
+          cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty(); });
+        }
+        drain();
       }
+      // Stop listening, then write what arrived before the stop: nothing received is lost.
+      dds.close();
       drain();
+      writer.close();
+    } catch (const std::runtime_error& e) {
+      // An I/O failure (disk full, device gone): say exactly what the file
+      // holds and what was received but could not be written.
+      dds.close();
+      std::size_t unwritten;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        unwritten = queue.size() + not_written;
+      }
+      try {
+        writer.close();
+      } catch (const std::exception&) {
+      }
+      throw std::runtime_error(fmt::format(
+          "{}; recording stopped: {} messages were handed to the file, {} more received were not written; "
+          "{} reads up to its last complete chunk (ddswarm-record info)",
+          e.what(), total_written(), unwritten, opt.path));
     }
-    // Stop listening, then write what arrived before the stop: nothing received is lost.
-    dds.close();
-    drain();
-    writer.close();
     RecorderCounts c;
     c.messages = written;
     c.bytes = writer.bytes_written();
@@ -178,7 +210,7 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
   std::map<std::uint16_t, std::function<void(std::span<const std::uint8_t>)>> publish;
   for (const auto& [id, ch] : r.channels()) {
     if (!topics.empty() && std::find(topics.begin(), topics.end(), ch.topic) == topics.end()) continue;
-    for_each_topic_type([&, id = id]<class T>() {
+    for_each_topic_type([&, id = id, &ch = ch]<class T>() {  // clang 14 cannot capture a structured binding
       if (ch.topic != Topic<T>::name) return;
       auto w = std::make_shared<Writer<T>>(dds.writer<T>());
       publish[id] = [w](std::span<const std::uint8_t> bytes) {

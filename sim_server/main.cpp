@@ -6,6 +6,7 @@
 
 #include "common/cli_checks.hpp"
 #include "common/process.hpp"
+#include "common/shm_clean.hpp"
 #include "sim_server/sim_server.hpp"
 
 int main(int argc, char** argv) {
@@ -37,6 +38,11 @@ int main(int argc, char** argv) {
     ddswarm::default_security_role(cfg.dds, "server");
     cfg.validate();
     ddswarm::install_stop_signals();
+    // Segments that crashed runs left in /dev/shm pile up until the next run
+    // cannot map its own: clear the zombies (never a live process's) first.
+    if (auto r = ddswarm::clean_zombie_shm(); r.files_removed > 0)
+      spdlog::info("removed {} shared-memory files ({:.1f} MB) left by crashed processes",
+                   r.files_removed, r.bytes_freed / 1e6);
     ddswarm::sim::SimServer server(std::move(cfg));
     server.run(duration_s);
     return 0;

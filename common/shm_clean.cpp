@@ -1,0 +1,106 @@
+#include "common/shm_clean.hpp"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <set>
+#include <vector>
+
+namespace ddswarm {
+namespace {
+
+bool starts_with(const std::string& s, const std::string& p) { return s.rfind(p, 0) == 0; }
+bool ends_with(const std::string& s, const std::string& p) {
+  return s.size() >= p.size() && s.compare(s.size() - p.size(), p.size(), p) == 0;
+}
+
+std::vector<std::string> list_dir(const std::string& dir) {
+  std::vector<std::string> out;
+  if (DIR* d = opendir(dir.c_str())) {
+    while (dirent* e = readdir(d)) {
+      std::string n = e->d_name;
+      if (n != "." && n != "..") out.push_back(n);
+    }
+    closedir(d);
+  }
+  return out;
+}
+
+/// True when some process holds an flock on path (as Fast DDS's owners do).
+bool locked(const std::string& path) {
+  int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return true;  // cannot tell: leave it
+  bool held = flock(fd, LOCK_EX | LOCK_NB) != 0;
+  if (!held) flock(fd, LOCK_UN);
+  close(fd);
+  return held;
+}
+
+/// Every file under dir that some live process maps.
+std::set<std::string> mapped_files(const std::string& dir) {
+  std::set<std::string> out;
+  const std::string prefix = dir + "/";
+  for (const auto& pid : list_dir("/proc")) {
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream maps("/proc/" + pid + "/maps");
+    std::string line;
+    while (std::getline(maps, line)) {
+      auto at = line.find(prefix);
+      if (at == std::string::npos) continue;
+      std::string path = line.substr(at);
+      if (ends_with(path, " (deleted)")) continue;
+      out.insert(path.substr(prefix.size()));
+    }
+  }
+  return out;
+}
+
+void remove(const std::string& dir, const std::string& name, ShmCleanReport& r) {
+  const std::string path = dir + "/" + name;
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) return;
+  if (unlink(path.c_str()) == 0) {
+    ++r.files_removed;
+    r.bytes_freed += static_cast<std::uint64_t>(st.st_blocks) * 512u;
+  }
+}
+
+}  // namespace
+
+ShmCleanReport clean_zombie_shm(const std::string& dir) {
+  ShmCleanReport r;
+  const auto names = list_dir(dir);
+  const std::set<std::string> present(names.begin(), names.end());
+  std::set<std::string> mapped;
+  bool have_mapped = false;
+  for (const auto& n : names) {
+    if (starts_with(n, "fastrtps_") && (ends_with(n, "_el") || ends_with(n, "_sl"))) {
+      // A transport segment or port and its lock: owner alive <=> lock held.
+      if (locked(dir + "/" + n)) {
+        ++r.in_use;
+        continue;
+      }
+      const std::string base = n.substr(0, n.size() - 3);
+      remove(dir, base, r);
+      remove(dir, n, r);
+      if (starts_with(base, "fastrtps_port")) remove(dir, "sem." + base + "_mutex", r);
+    } else if (starts_with(n, "fast_datasharing_")) {
+      if (!have_mapped) {
+        mapped = mapped_files(dir);
+        have_mapped = true;
+      }
+      if (mapped.count(n)) {
+        ++r.in_use;
+        continue;
+      }
+      remove(dir, n, r);
+    }
+  }
+  return r;
+}
+
+}  // namespace ddswarm

@@ -1,0 +1,27 @@
+#pragma once
+// Removes the shared-memory files that crashed Fast DDS processes leave in
+// /dev/shm, as `fastdds shm clean` does, plus the data-sharing segments that
+// tool does not know. A killed process cannot unlink its segments; enough of
+// them fill /dev/shm and break the next run.
+//
+// A file is a zombie only when no live process can be using it:
+//   fastrtps_<id> / fastrtps_port<N> (SHM transport): their "_el"/"_sl" lock
+//     file is not flock()ed by anyone (the owner holds it while alive);
+//   fast_datasharing_<guid>_<entity> (data-sharing pools): no process maps it
+//     (/proc/*/maps).
+// Files in use by any live process, of any domain or user, are never touched.
+#include <cstdint>
+#include <string>
+
+namespace ddswarm {
+
+struct ShmCleanReport {
+  int files_removed = 0;
+  std::uint64_t bytes_freed = 0;
+  int in_use = 0;  ///< segments and ports left alone because a live process holds them
+};
+
+/// Cleans dir (default /dev/shm). Never throws; unreadable entries are skipped.
+ShmCleanReport clean_zombie_shm(const std::string& dir = "/dev/shm");
+
+}  // namespace ddswarm

@@ -1,0 +1,76 @@
+#include "common/shm_clean.hpp"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/file.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+using ddswarm::clean_zombie_shm;
+
+namespace {
+
+struct TempDir {
+  std::string path;
+  TempDir() {
+    char tmpl[] = "/tmp/ddswarm-shm-test.XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() { std::system(("rm -rf " + path).c_str()); }
+  std::string touch(const std::string& name, std::size_t bytes = 4096) const {
+    std::string p = path + "/" + name;
+    std::ofstream(p) << std::string(bytes, 'x');
+    return p;
+  }
+  bool has(const std::string& name) const { return access((path + "/" + name).c_str(), F_OK) == 0; }
+};
+
+}  // namespace
+
+TEST(ShmClean, RemovesTransportSegmentsAndPortsWhoseOwnerIsGone) {
+  TempDir d;
+  d.touch("fastrtps_0123456789abcdef");
+  d.touch("fastrtps_0123456789abcdef_el", 0);
+  d.touch("fastrtps_port7411");
+  d.touch("fastrtps_port7411_el", 0);
+  d.touch("sem.fastrtps_port7411_mutex", 32);
+  d.touch("unrelated_file");
+  auto r = clean_zombie_shm(d.path);
+  EXPECT_EQ(r.files_removed, 5);
+  EXPECT_GT(r.bytes_freed, 0u);
+  EXPECT_FALSE(d.has("fastrtps_0123456789abcdef"));
+  EXPECT_FALSE(d.has("fastrtps_port7411"));
+  EXPECT_FALSE(d.has("sem.fastrtps_port7411_mutex"));
+  EXPECT_TRUE(d.has("unrelated_file")) << "only Fast DDS's files are touched";
+}
+
+TEST(ShmClean, KeepsWhatALiveProcessHolds) {
+  TempDir d;
+  d.touch("fastrtps_00000000000000aa");
+  std::string lock = d.touch("fastrtps_00000000000000aa_el", 0);
+  int fd = open(lock.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(flock(fd, LOCK_EX), 0);  // as the owning participant does while it lives
+
+  std::string seg = d.touch("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.00_0.0.1.4");
+  int sfd = open(seg.c_str(), O_RDWR);
+  ASSERT_GE(sfd, 0);
+  void* m = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, sfd, 0);
+  ASSERT_NE(m, MAP_FAILED);
+  d.touch("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.01_0.0.1.4");  // nobody maps it
+
+  auto r = clean_zombie_shm(d.path);
+  EXPECT_TRUE(d.has("fastrtps_00000000000000aa"));
+  EXPECT_TRUE(d.has("fastrtps_00000000000000aa_el"));
+  EXPECT_TRUE(d.has("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.00_0.0.1.4"));
+  EXPECT_FALSE(d.has("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.01_0.0.1.4"));
+  EXPECT_EQ(r.files_removed, 1);
+  EXPECT_EQ(r.in_use, 2);
+  munmap(m, 4096);
+  close(sfd);
+  close(fd);
+}
