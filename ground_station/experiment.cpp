@@ -126,6 +126,10 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
         auto common_args = [&](std::vector<std::string> a) {
           a.push_back("--domain");
           a.push_back(std::to_string(opt.dds.domain_id));
+          if (opt.dds.secure()) {  // each child takes its own role's identity
+            a.push_back("--secure");
+            a.push_back(opt.dds.security_dir);
+          }
           return a;
         };
         if (!opt.record_dir.empty()) {
