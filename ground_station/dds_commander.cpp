@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <map>
@@ -125,10 +127,17 @@ struct DdsCommander::Impl {
   /// on timeout or when a stop was requested.
   template <class Pred>
   bool wait(double timeout_s, Pred done) {
+    using namespace std::chrono;
+    const auto end = steady_clock::now() + duration_cast<steady_clock::duration>(duration<double>(timeout_s));
     std::unique_lock<std::mutex> lock(mu);
-    return cv.wait_for(lock, std::chrono::duration<double>(timeout_s),
-                       [&] { return stop_requested() || done(); }) &&
-           !stop_requested();
+    // A signal handler cannot notify cv, and with no server nothing else
+    // does: look at the stop flag (Ctrl-C) every 100 ms.
+    while (!stop_requested() && !done()) {
+      const auto now = steady_clock::now();
+      if (now >= end) return false;
+      cv.wait_for(lock, std::min<steady_clock::duration>(end - now, milliseconds(100)));
+    }
+    return !stop_requested();
   }
 
   /// The server hears our commands and every online agent's acks reach us. mu held.

@@ -81,7 +81,7 @@ bool finite_all(std::initializer_list<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return run_main("ddswarm-gs", [&]() -> int {
+  const int rc = run_main("ddswarm-gs", [&]() -> int {
     CLI::App app{"ddswarm-gs: the ground station (console, scripted commands, experiments)"};
     app.require_subcommand(0, 1);
     std::string config;
@@ -201,6 +201,7 @@ int main(int argc, char** argv) {
     const bool ready = (*status || (*task && attach)) ? gs.wait_for_status(file.gs.discovery_timeout_s)
                                : gs.wait_for_server(file.gs.discovery_timeout_s);
     if (!ready && !interactive) {
+      if (stop_requested()) return 1;  // interrupted while discovering: reported below
       std::fprintf(stderr, "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",
                    file.dds.domain_id, file.gs.discovery_timeout_s);
       return 1;
@@ -296,4 +297,11 @@ int main(int argc, char** argv) {
     }
     return 0;
   });
+  // Ctrl-C or SIGTERM cut a subcommand short: say so (the menu and trace end
+  // normally on it and keep their 0).
+  if (stop_requested() && rc != 0 && rc != 2) {
+    std::fprintf(stderr, "ddswarm-gs: interrupted\n");
+    return 130;
+  }
+  return rc;
 }

@@ -14,3 +14,5 @@ set_tests_properties(mp_network_safety PROPERTIES SKIP_RETURN_CODE 77)
 add_executable(malformed_publisher malformed_publisher.cpp)
 target_link_libraries(malformed_publisher PRIVATE ddswarm_common)
 ddswarm_process_test(mp_malformed_samples 60 malformed_samples_test.sh)
+# Bad command-line input (NaN, inf, huge, garbage), Ctrl-C, and the console at end of input.
+ddswarm_process_test(mp_cli_bad_input 90 cli_bad_input_test.sh)
