@@ -24,6 +24,7 @@ const TRAIL_MAX_SLOTS = 480;
 const TRAIL_LIFE = 120;              // s of sim time a trail point stays visible
 const FLASH_MS = 900;
 
+const HEX = Array.from({ length: 14 }, (_, i) => (i % 2 ? Math.sin : Math.cos)((Math.floor(i / 2) * Math.PI) / 3));
 const COL_FAILSAFE = new THREE.Color(0xf3a531);
 const COL_LOST = new THREE.Color(0x7a828c);
 const COL_FLASH = new THREE.Color(0xff2222);
@@ -44,7 +45,9 @@ export function droneColour(id, out = new THREE.Color()) {
 // look the same lit per vertex as per pixel.
 // Vertex attributes: color (paint), bodyMask (1: takes the drone's instance
 // colour), rotor (k: spins with rotor k; -1: rigid).
-function quadGeometry(arm) {
+// lite (quality low): body, arms and blades only, under 100 vertices; the
+// front arm is red instead of a nose.
+function quadGeometry(arm, lite = false) {
   const parts = [];
   const add = (geo, hex, { body = 0, rotor = -1 } = {}) => {
     geo.deleteAttribute('uv');
@@ -58,15 +61,20 @@ function quadGeometry(arm) {
   };
   const bodyL = arm * 0.95, bodyW = arm * 0.62, bodyH = arm * 0.3;
   add(new THREE.BoxGeometry(bodyL, bodyW, bodyH), 0xffffff, { body: 1 });
-  add(new THREE.SphereGeometry(bodyW * 0.42, 6, 2, 0, Math.PI * 2, 0, Math.PI / 2).scale(1.3, 1, 0.8).translate(0, 0, bodyH / 2), 0xdde3ea);
-  add(new THREE.BoxGeometry(arm * 0.12, arm * 0.22, arm * 0.12).translate(bodyL / 2, 0, 0), 0xff4d2e);  // nose: the front (body +x)
-  // Two straight arms: rotor 0 (-45 deg) to 1 (135), rotor 2 (45) to 3 (-135).
-  add(new THREE.BoxGeometry(2 * arm, arm * 0.09, arm * 0.07).rotateZ(ROTOR_ANGLE[0]), 0x2f333a);
-  add(new THREE.BoxGeometry(2 * arm, arm * 0.09, arm * 0.07).rotateZ(ROTOR_ANGLE[2]), 0x2f333a);
+  if (!lite) add(new THREE.SphereGeometry(bodyW * 0.42, 6, 2, 0, Math.PI * 2, 0, Math.PI / 2).scale(1.3, 1, 0.8).translate(0, 0, bodyH / 2), 0xdde3ea);
+  if (!lite) add(new THREE.BoxGeometry(arm * 0.12, arm * 0.22, arm * 0.12).translate(bodyL / 2, 0, 0), 0xff4d2e);  // nose: the front (body +x)
+  if (lite) {
+    // Four arms, the front two red.
+    for (let k = 0; k < 4; k++) add(new THREE.BoxGeometry(arm, arm * 0.1, arm * 0.08).translate(arm / 2, 0, 0).rotateZ(ROTOR_ANGLE[k]), k === 0 || k === 2 ? 0xd8432a : 0x2f333a);
+  } else {
+    // Two straight arms: rotor 0 (-45 deg) to 1 (135), rotor 2 (45) to 3 (-135).
+    add(new THREE.BoxGeometry(2 * arm, arm * 0.09, arm * 0.07).rotateZ(ROTOR_ANGLE[0]), 0x2f333a);
+    add(new THREE.BoxGeometry(2 * arm, arm * 0.09, arm * 0.07).rotateZ(ROTOR_ANGLE[2]), 0x2f333a);
+  }
   const rotorZ = arm * 0.17, prop = arm * 0.55;
   for (let k = 0; k < 4; k++) {
     const cx = Math.cos(ROTOR_ANGLE[k]) * arm, cy = Math.sin(ROTOR_ANGLE[k]) * arm;
-    add(new THREE.CylinderGeometry(arm * 0.07, arm * 0.1, arm * 0.24, 6, 1, true).rotateX(Math.PI / 2).translate(cx, cy, arm * 0.05), 0x1b1d21);
+    if (!lite) add(new THREE.CylinderGeometry(arm * 0.07, arm * 0.1, arm * 0.24, 6, 1, true).rotateX(Math.PI / 2).translate(cx, cy, arm * 0.05), 0x1b1d21);
     add(new THREE.PlaneGeometry(2 * prop, arm * 0.1).translate(cx, cy, rotorZ), k < 2 ? 0x0d0f12 : 0x2a2e35, { rotor: k });
   }
   return { geo: mergeGeometries(parts), rotorZ, prop, centres: ROTOR_ANGLE.map((a) => new THREE.Vector3(Math.cos(a) * arm, Math.sin(a) * arm, rotorZ)) };
@@ -168,7 +176,10 @@ export class Drones {
     };
     this.phase = new THREE.InstancedBufferAttribute(new Float32Array(4 * n), 4).setUsage(THREE.DynamicDrawUsage);
     g.geo.setAttribute('rotorPhase', this.phase);
-    this.quads = mk(g.geo, quadMaterial(g.centres), n);
+    this.geoFull = g.geo;
+    this.geoLite = quadGeometry(this.arm, true).geo;
+    this.geoLite.setAttribute('rotorPhase', this.phase);
+    this.quads = mk(this.blobShadows ? this.geoLite : this.geoFull, quadMaterial(g.centres), n);
     this.quads.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
     // Blur discs while the motors turn (not at quality low: one more instance a drone).
     this.discs = mk(discsGeometry(g.centres, g.prop), new THREE.MeshBasicMaterial({ color: 0xcfd6de, transparent: true, opacity: 0.22, depthWrite: false, side: THREE.DoubleSide }), n, false);
@@ -176,8 +187,15 @@ export class Drones {
     this.rings = mk(new THREE.RingGeometry(this.arm * 2.0, this.arm * 2.5, 24), new THREE.MeshBasicMaterial({ color: 0xffffff, transparent: true, opacity: 0.9, depthWrite: false, side: THREE.DoubleSide }), n, false);
     this.rings.instanceColor = new THREE.InstancedBufferAttribute(new Float32Array(3 * n), 3).setUsage(THREE.DynamicDrawUsage);
     // Blob shadows, for when the world has no shadow maps (quality low).
-    this.blobs = mk(new THREE.CircleGeometry(this.arm * 1.15, 10), new THREE.MeshBasicMaterial({ color: 0x000000, transparent: true, opacity: 0.22, depthWrite: false }), n, false);
+    // Blob shadows (quality low): one plain geometry of n hexagons moved on
+    // the CPU, not an InstancedMesh: on SwiftShader 128 instances of a tiny
+    // transparent disc cost more than rewriting 128 x 18 vertices.
+    const bg = new THREE.BufferGeometry();
+    bg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(n * 18 * 3), 3).setUsage(THREE.DynamicDrawUsage));
+    this.blobs = new THREE.Mesh(bg, new THREE.MeshBasicMaterial({ color: 0x000000, transparent: true, opacity: 0.22, depthWrite: false }));
+    this.blobs.frustumCulled = false;
     this.blobs.visible = this.blobShadows;
+    this.group.add(this.blobs);
 
     this.pos = new Float64Array(3 * n);       // as rendered
     this.quat = new Float32Array(4 * n);
@@ -233,6 +251,8 @@ export class Drones {
   }
 
   dispose() {
+    this.geoFull?.dispose();
+    this.geoLite?.dispose();
     for (const c of [...this.group.children]) {
       this.group.remove(c);
       c.geometry?.dispose();
@@ -359,7 +379,10 @@ export class Drones {
     this.blobShadows = on;
     if (this.blobs) this.blobs.visible = on;
     if (this.discs) this.discs.visible = !on;
-    if (this.quads) this.quads.castShadow = !on;
+    if (this.quads) {
+      this.quads.castShadow = !on;
+      this.quads.geometry = on ? this.geoLite : this.geoFull;
+    }
   }
 
   setTrails(on) {
@@ -423,16 +446,24 @@ export class Drones {
         ringN++;
       }
       if (this.blobShadows) {
-        const k = sc * Math.max(0.35, 1 - (p.z - this.groundZ) / 25);
-        r.makeTranslation(p.x, p.y, this.groundZ + 0.02);
-        this.blobs.setMatrixAt(b, r.scale(s.set(k, k, k)));
+        const rad = this.arm * 1.15 * sc * Math.max(0.35, 1 - (p.z - this.groundZ) / 25), z = this.groundZ + 0.02;
+        const B = this.blobs.geometry.attributes.position.array;
+        for (let k = 0, o = 54 * b; k < 6; k++, o += 9) {
+          B[o] = p.x; B[o + 1] = p.y; B[o + 2] = z;
+          B[o + 3] = p.x + rad * HEX[2 * k]; B[o + 4] = p.y + rad * HEX[2 * k + 1]; B[o + 5] = z;
+          B[o + 6] = p.x + rad * HEX[2 * k + 2]; B[o + 7] = p.y + rad * HEX[2 * k + 3]; B[o + 8] = z;
+        }
       }
       b++;
     }
-    this.quads.count = this.blobs.count = b;
+    this.quads.count = b;
+    if (this.blobShadows) {
+      this.blobs.geometry.setDrawRange(0, 18 * b);
+      this.blobs.geometry.attributes.position.needsUpdate = true;
+    }
     this.rings.count = ringN;
     this.discs.count = discN;
-    for (const mesh of [this.quads, this.discs, this.rings, this.blobs]) mesh.instanceMatrix.needsUpdate = true;
+    for (const mesh of [this.quads, this.discs, this.rings]) mesh.instanceMatrix.needsUpdate = true;
     this.phase.needsUpdate = true;
     const u = this.quads.material.uniforms;
     if (this.sun) {

@@ -169,7 +169,6 @@ function loop(now) {
   if (state.frameNew && state.frame && drones.n) {
     state.frameNew = false;
     drones.applyFrame(state.frame, now);
-    panel.setTime(state.frame.t);
     if (!state.framed) {
       const c = drones.centroid();
       if (c) { world.frame(c, c.radius); state.framed = true; }
@@ -178,6 +177,7 @@ function loop(now) {
   if (now - tableAt > 250) {
     tableAt = now;
     panel.updateTable(state.frame, (i) => drones.isLost(i), now);
+    if (state.frame) panel.setTime(state.frame.t);  // text changes cost layout and paint: 4 Hz
     if (state.source === 'replay' && state.frame) panel.setStatus(statusOfFrame(state.frame));
   }
   drones.update(dt, now);

@@ -97,6 +97,7 @@ export class World {
     this.topControls.enabled = false;
     this.topHeight = 60;  // m of world shown vertically at zoom 1
 
+    this.litMeshes = [];
     this.mode = 'orbit';
     this.followTarget = new THREE.Vector3();
     this.followValid = false;
@@ -117,11 +118,17 @@ export class World {
     r.shadowMap.type = q === 'high' ? THREE.PCFShadowMap : THREE.BasicShadowMap;
     r.shadowMap.needsUpdate = true;
     if (this.ground) this.ground.visible = q !== 'low';
+    this.applyLitQuality();
     this.sky.visible = q === 'low';
     this.scene.background = q === 'low' ? this.groundColour : this.skyColour;
     this.scene.traverse((o) => { if (o.material) [].concat(o.material).forEach((m) => { m.needsUpdate = true; }); });
     this.resize();
     this.onQuality?.(q);
+  }
+
+  // Quality low lights the pillars and boxes per vertex (cheaper pixels).
+  applyLitQuality() {
+    for (const m of this.litMeshes ?? []) m.material = this.quality === 'low' ? m.userData.flat : m.userData.lit;
   }
 
   // One step down, for 'auto' when frames are slow; false at the bottom.
@@ -154,6 +161,7 @@ export class World {
       });
     }
     const g = this.staticGroup;
+    this.litMeshes = [];
     const z0 = s.ground_z ?? 0;
     const bmin = new THREE.Vector3(...(s.bounds_min ?? [-40, -20, z0]));
     const bmax = new THREE.Vector3(...(s.bounds_max ?? [40, 100, z0 + 30]));
@@ -184,6 +192,7 @@ export class World {
     if (cyl.length) {
       const geo = new THREE.CylinderGeometry(1, 1, 1, 40).rotateX(Math.PI / 2).translate(0, 0, 0.5);
       const mesh = new THREE.InstancedMesh(geo, concrete, cyl.length);
+      this.litMeshes.push(mesh);
       const m = new THREE.Matrix4();
       cyl.forEach((c, i) => mesh.setMatrixAt(i, m.makeScale(c.r, c.r, c.h).setPosition(c.x, c.y, z0)));
       mesh.castShadow = mesh.receiveShadow = true;
@@ -193,6 +202,7 @@ export class World {
     const boxes = s.boxes ?? [];
     if (boxes.length) {
       const mesh = new THREE.InstancedMesh(new THREE.BoxGeometry(1, 1, 1), surface({ color: 0xb9a48a, roughness: 0.8 }), boxes.length);
+      this.litMeshes.push(mesh);
       const m = new THREE.Matrix4(), q = new THREE.Quaternion();
       boxes.forEach((b, i) => {
         q.setFromAxisAngle(Z_UP, b.yaw ?? 0);
@@ -256,6 +266,8 @@ export class World {
     Object.assign(sc, { left: -half, right: half, top: half, bottom: -half, near: 1, far: 2 * half + size.z + 100 });
     sc.updateProjectionMatrix();
 
+    for (const m of this.litMeshes) { m.userData.lit = m.material; m.userData.flat = vertexLit(m.material.color, this); }
+    this.applyLitQuality();
     this.scene.fog.near = 1.2 * Math.max(size.x, size.y);
     this.scene.fog.far = 4 * Math.max(size.x, size.y) + 200;
     this.fitTop();
@@ -307,6 +319,48 @@ export class World {
     this.sky.position.copy(cam.position);
     this.renderer.render(this.scene, cam);
   }
+}
+
+// Lambert lit per vertex under the world's hemisphere light and sun (for
+// quality low; the same formula as three's per-pixel MeshLambertMaterial).
+function vertexLit(colour, world) {
+  const sunDir = new THREE.Vector3().subVectors(world.sun.position, world.sun.target.position).normalize();
+  return new THREE.ShaderMaterial({
+    fog: true,
+    uniforms: THREE.UniformsUtils.merge([THREE.UniformsLib.fog, {
+      uColour: { value: colour.clone() },
+      uSunDir: { value: sunDir },
+      uSun: { value: world.sun.color.clone().multiplyScalar(world.sun.intensity) },
+      uSky: { value: world.hemi.color.clone().multiplyScalar(world.hemi.intensity) },
+      uGround: { value: world.hemi.groundColor.clone().multiplyScalar(world.hemi.intensity) },
+    }]),
+    vertexShader: `
+      #include <common>
+      #include <fog_pars_vertex>
+      uniform vec3 uColour, uSunDir, uSun, uSky, uGround;
+      varying vec3 vLit;
+      void main() {
+        mat4 m = modelMatrix;
+        #ifdef USE_INSTANCING
+          m = m * instanceMatrix;
+        #endif
+        vec3 n = normalize(mat3(m) * normal);
+        vLit = uColour * (mix(uGround, uSky, 0.5 * n.z + 0.5) + uSun * max(dot(n, uSunDir), 0.0)) * RECIPROCAL_PI;
+        vec4 mvPosition = viewMatrix * m * vec4(position, 1.0);
+        gl_Position = projectionMatrix * mvPosition;
+        #include <fog_vertex>
+      }`,
+    fragmentShader: `
+      #include <common>
+      #include <fog_pars_fragment>
+      varying vec3 vLit;
+      void main() {
+        gl_FragColor = vec4(vLit, 1.0);
+        #include <tonemapping_fragment>
+        #include <colorspace_fragment>
+        #include <fog_fragment>
+      }`,
+  });
 }
 
 // The sky above the horizon (and a band below it fading to the ground
