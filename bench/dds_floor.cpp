@@ -53,9 +53,10 @@ msg::SwarmState make_state(int n) {
   return s;
 }
 
-DdsConfig dds_for(int domain, const std::string& server) {
+DdsConfig dds_for(int domain, const std::string& server, int participant_id = -1) {
   DdsConfig c;
   c.domain_id = domain;
+  c.participant_id = participant_id;
   if (!server.empty()) {
     c.discovery = Discovery::kDiscoveryServer;
     c.discovery_server = server;
@@ -64,9 +65,9 @@ DdsConfig dds_for(int domain, const std::string& server) {
 }
 
 /// Responder: answers every SwarmState with one VelocityCommand, inside the callback.
-int respond(int id, int domain, const std::string& server, double duration_s) {
+int respond(int id, int domain, const std::string& server, double duration_s, int participant_id) {
   install_stop_signals();
-  Participant p(dds_for(domain, server), "dds_floor responder " + std::to_string(id));
+  Participant p(dds_for(domain, server, participant_id), "dds_floor responder " + std::to_string(id));
   auto w = p.writer<msg::VelocityCommand>();
   msg::VelocityCommand cmd;
   cmd.drone_id(static_cast<std::uint16_t>(id));
@@ -110,8 +111,8 @@ double cpu_between(const std::map<pid_t, ProcSample>& a, const std::map<pid_t, P
   return s;
 }
 
-Result run_one(int n, bool use_server, int domain, double warmup_s, double measure_s, double idle_s,
-               double discovery_timeout_s, const std::string& log_dir) {
+Result run_one(int n, bool use_server, bool explicit_ids, int domain, double warmup_s, double measure_s,
+               double idle_s, double discovery_timeout_s, const std::string& log_dir) {
   Result r;
   r.n = n;
   r.discovery = use_server ? "server" : "simple";
@@ -131,12 +132,16 @@ Result run_one(int n, bool use_server, int domain, double warmup_s, double measu
       a.push_back("--discovery-server");
       a.push_back(server);
     }
+    if (explicit_ids) {
+      a.push_back("--participant-id");
+      a.push_back(std::to_string(i + 1));
+    }
     kids.push_back(spawn(a, log_dir.empty() ? "" : fmt::format("{}/responder-{}.log", log_dir, i)));
   }
   std::vector<pid_t> all = kids;
   all.push_back(getpid());
   {
-    Participant p(dds_for(domain, server), "dds_floor publisher");
+    Participant p(dds_for(domain, server, explicit_ids ? 0 : -1), "dds_floor publisher");
     auto w = p.writer<msg::SwarmState>();
     std::mutex mu;
     std::condition_variable cv;
@@ -238,7 +243,8 @@ int main(int argc, char** argv) {
     std::vector<int> sizes = {6, 16, 32, 64, 128};
     std::string discovery = "both", csv, log_dir;
     double warmup_s = 2, measure_s = 5, idle_s = 2, discovery_timeout_s = 120, duration_s = 600;
-    int simple_max = 64, domain = -1, respond_id = -1;
+    int simple_max = 64, domain = -1, respond_id = -1, participant_id = -1;
+    bool explicit_ids = false;
     std::string server;
     app.add_option("--drones", sizes, "swarm sizes to measure")->delimiter(',');
     app.add_option("--discovery", discovery, "simple | server | both")
@@ -253,6 +259,10 @@ int main(int argc, char** argv) {
     app.add_option("--domain", domain, "DDS domain (default: random in 100-199)");
     app.add_option("--csv", csv, "append one row per run to this CSV");
     app.add_option("--log-dir", log_dir, "responder and discovery-server logs (default: discarded)");
+    app.add_flag("--explicit-ids", explicit_ids,
+                 "give every participant its RTPS participant id (publisher 0, responder i: i+1) instead of "
+                 "Fast DDS's automatic one; needs N <= 119 (dds.participant_id's range)");
+    app.add_option("--participant-id", participant_id, "internal: responder's participant id")->group("");
     app.add_option("--respond", respond_id, "internal: run as responder ID")->group("");
     app.add_option("--discovery-server", server, "internal: responder's discovery server")->group("");
     app.add_option("--duration", duration_s, "internal: responder's lifetime (s)")->group("");
@@ -262,7 +272,7 @@ int main(int argc, char** argv) {
       return app.exit(e) == 0 ? 0 : 2;
     }
     if (domain < 0) domain = 100 + static_cast<int>(random_instance() % 100);
-    if (respond_id >= 0) return respond(respond_id, domain, server, duration_s);
+    if (respond_id >= 0) return respond(respond_id, domain, server, duration_s, participant_id);
     install_stop_signals();
     if (!log_dir.empty()) std::filesystem::create_directories(log_dir);
 
@@ -281,7 +291,15 @@ int main(int argc, char** argv) {
           continue;
         }
         std::fprintf(stderr, "dds_floor: N=%d, %s discovery ...\n", n, use_server ? "server" : "simple");
-        Result r = run_one(n, use_server, domain, warmup_s, measure_s, idle_s, discovery_timeout_s, log_dir);
+        if (explicit_ids && n > 119) {
+          Result r;
+          r.n = n;
+          r.discovery = use_server ? "server" : "simple";
+          r.why = "skipped: explicit ids need N <= 119 (dds.participant_id range)";
+          results.push_back(r);
+          continue;
+        }
+        Result r = run_one(n, use_server, explicit_ids, domain, warmup_s, measure_s, idle_s, discovery_timeout_s, log_dir);
         std::fprintf(stderr, "dds_floor: N=%d %s: %s\n", n, r.discovery.c_str(),
                      r.ok ? fmt::format("{:.0f} ticks/s", r.ticks_per_s).c_str() : r.why.c_str());
         results.push_back(r);

@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# Issue 8: where the time goes in a flying swarm. Launches N agent processes
+# (lockstep or real time), takes off, holds, then samples the server and one
+# agent with perf (cpu-clock, user space) for a few seconds and prints the
+# share of each library and the hottest symbols, plus user/system CPU split.
+# Usage: bench/profile_swarm.sh [--bin DIR] [--mode lockstep|realtime] [--time S] [--out DIR] N...
+set -u
+SRC="$(cd "$(dirname "$0")/.." && pwd)"
+BIN="$SRC/build/default/bin"
+MODE=lockstep
+SECS=8
+OUT=""
+SIZES=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --bin) BIN="$2"; shift 2 ;;
+    --mode) MODE="$2"; shift 2 ;;
+    --time) SECS="$2"; shift 2 ;;
+    --out) OUT="$2"; shift 2 ;;
+    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    *) SIZES+=("$1"); shift ;;
+  esac
+done
+[ ${#SIZES[@]} -gt 0 ] || SIZES=(6 64 128)
+command -v perf >/dev/null || { echo "profile_swarm: perf not installed (Debian linux-perf)" >&2; exit 2; }
+[ -n "$OUT" ] || OUT="$(mktemp -d /tmp/ddswarm-profile.XXXXXX)"
+mkdir -p "$OUT"
+SCENARIO="$SRC/config/thesis_course.yaml"
+LAUNCH_PID=""
+stop_launch() {
+  [ -n "$LAUNCH_PID" ] || return 0
+  kill -TERM "$LAUNCH_PID" 2>/dev/null
+  for _ in $(seq 150); do kill -0 "$LAUNCH_PID" 2>/dev/null || break; sleep 0.1; done
+  kill -KILL "$LAUNCH_PID" 2>/dev/null
+  wait "$LAUNCH_PID" 2>/dev/null
+  LAUNCH_PID=""
+}
+trap stop_launch EXIT
+trap 'exit 130' INT TERM
+
+cpu_split() {  # cpu_split PID -> "user_s sys_s"
+  awk '{ sub(/.*\) /, ""); print $12 / 100, $13 / 100 }' "/proc/$1/stat" 2>/dev/null
+}
+
+report() {  # report NAME DATA
+  echo "-- $1: share by library --"
+  perf report -i "$2" --no-children --sort dso --stdio 2>/dev/null | grep -E '^ +[0-9]' | head -8
+  echo "-- $1: hottest symbols --"
+  perf report -i "$2" --no-children --sort dso,sym --stdio 2>/dev/null | grep -E '^ +[0-9]' | head -25 |
+    cut -c1-160
+}
+
+for n in "${SIZES[@]}"; do
+  dom=$(( (RANDOM % 100) + 120 ))
+  log="$OUT/$MODE-$n"
+  mkdir -p "$log"
+  "$BIN/ddswarm-launch" "$SCENARIO" --drones "$n" --mode "$MODE" --domain "$dom" --log-dir "$log" \
+    --discovery-server auto --duration 900 >"$log/launch.out" 2>"$log/launch.err" &
+  LAUNCH_PID=$!
+  for _ in $(seq 50); do grep -q "started .* process" "$log/launch.err" 2>/dev/null && break; sleep 0.1; done
+  ds=()
+  addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$log/launch.err")
+  [ -n "$addr" ] && ds=(--discovery-server "$addr")
+  gs=("$BIN/ddswarm-gs" --config "$SCENARIO" --domain "$dom" "${ds[@]}")
+  timeout 320 "${gs[@]}" wait-agents --count "$n" --timeout 300 >/dev/null 2>&1 || { echo "N=$n: agents not online"; stop_launch; continue; }
+  timeout 260 "${gs[@]}" takeoff --wait >/dev/null 2>&1 || { echo "N=$n: takeoff failed"; stop_launch; continue; }
+  timeout 60 "${gs[@]}" hold --time 86400 >/dev/null 2>&1
+  sleep 2
+  sim=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
+  agent=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
+  read -r su0 ss0 < <(cpu_split "$sim"); read -r au0 as0 < <(cpu_split "$agent")
+  perf record -q -e cpu-clock -F 999 -p "$sim" -o "$log/sim.perf" -- sleep "$SECS" >/dev/null 2>&1 &
+  p1=$!
+  perf record -q -e cpu-clock -F 999 -p "$agent" -o "$log/agent.perf" -- sleep "$SECS" >/dev/null 2>&1 &
+  p2=$!
+  wait $p1 $p2
+  read -r su1 ss1 < <(cpu_split "$sim"); read -r au1 as1 < <(cpu_split "$agent")
+  threads_sim=$(ls /proc/"$sim"/task | wc -l); threads_agent=$(ls /proc/"$agent"/task | wc -l)
+  stop_launch
+  echo
+  echo "==== $MODE, N=$n: ${SECS} s; load $(cut -d' ' -f1 /proc/loadavg) ===="
+  awk -v su="$(echo "$su1 - $su0" | bc)" -v ss="$(echo "$ss1 - $ss0" | bc)" -v au="$(echo "$au1 - $au0" | bc)" \
+      -v as="$(echo "$as1 - $as0" | bc)" -v t="$SECS" -v ts="$threads_sim" -v ta="$threads_agent" 'BEGIN {
+    printf "server: %.2f cores user + %.2f system (%d threads); agent 1: %.3f user + %.3f system (%d threads)\n",
+           su / t, ss / t, ts, au / t, as / t, ta }'
+  report "server (ddswarm-sim)" "$log/sim.perf"
+  report "agent 1" "$log/agent.perf"
+done
+echo "perf data in $OUT"
