@@ -210,10 +210,19 @@ int main(int argc, char** argv) {
       a.insert(a.end(), dds_args.begin(), dds_args.end());
       procs.start({"sim", a});
     }
+    if (!ids.empty() && agent_participant_id(n, ids.back()) < 0 && n > kExplicitParticipantIdsAbove)
+      std::cerr << fmt::format("ddswarm-launch: warning: {} drones: agents past drone {} get automatic participant "
+                               "ids, and past ~100 participants per host Fast DDS leaves them unreachable "
+                               "(dds.participant_id stops at {}; docs/performance.md)\n",
+                               n, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
     for (int id : ids) {
       std::vector<std::string> a = {bin + "/ddswarm-agent", "--id", std::to_string(id), "--config",
                                     scenario, "--drones", std::to_string(n)};
       a.insert(a.end(), dds_args.begin(), dds_args.end());
+      if (const int pid = agent_participant_id(n, id); pid >= 0) {
+        a.push_back("--participant-id");
+        a.push_back(std::to_string(pid));
+      }
       procs.start({"agent " + std::to_string(id), a});
     }
     std::cerr << fmt::format("ddswarm-launch: started {} process(es); policy on death: {}\n",

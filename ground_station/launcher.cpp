@@ -292,6 +292,12 @@ bool wants_local_discovery_server(const DiscoveryServerChoice& c, int drones, bo
   }
 }
 
+int agent_participant_id(int drones, int drone_id) {
+  if (drones <= kExplicitParticipantIdsAbove) return -1;
+  const int pid = kFirstAgentParticipantId + drone_id;
+  return pid <= kMaxParticipantId ? pid : -1;
+}
+
 ChildSpec discovery_server_spec(int port) {
   std::string exe;
   const char* path = std::getenv("PATH");

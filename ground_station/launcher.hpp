@@ -94,6 +94,19 @@ DiscoveryServerChoice parse_discovery_server(const std::string& text);
 /// discovers faster and idles cheaper (docs/performance.md, bench/dds_floor).
 constexpr int kAutoDiscoveryServerAbove = 32;
 
+/// Fast DDS 2.9 gives a participant with an automatic id the first free port
+/// pair among 100 (ids 0-99), so past ~100 participants per host and domain the
+/// rest are unreachable, discovery server or not (bench/dds_floor). Large
+/// swarms' agents therefore get explicit ids, from kFirstAgentParticipantId
+/// up, leaving ids below it for the server and tools (automatic).
+constexpr int kExplicitParticipantIdsAbove = 90;
+constexpr int kFirstAgentParticipantId = 4;
+constexpr int kMaxParticipantId = 119;  ///< dds.participant_id's upper bound (common/dds_config)
+
+/// The RTPS participant id the launcher gives drone_id's agent in a swarm of
+/// `drones`, or -1 for Fast DDS's automatic one.
+int agent_participant_id(int drones, int drone_id);
+
 /// True when the launcher should start its own server. `starts_whole_swarm`:
 /// it starts the server and every agent (a local server cannot serve a swarm
 /// split across hosts); `localhost_discovery`: no other network was opted into.

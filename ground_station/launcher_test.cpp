@@ -83,3 +83,11 @@ TEST(Launcher, DiscoveryServerChoice) {
   EXPECT_FALSE(wants_local_discovery_server(parse_discovery_server("off"), 128, true, true));
   EXPECT_FALSE(wants_local_discovery_server(ext, 128, true, true));
 }
+
+TEST(Launcher, LargeSwarmsAgentsGetExplicitParticipantIds) {
+  EXPECT_EQ(agent_participant_id(kExplicitParticipantIdsAbove, 0), -1);  // automatic ids suffice
+  EXPECT_EQ(agent_participant_id(110, 0), kFirstAgentParticipantId);
+  EXPECT_EQ(agent_participant_id(110, 109), kFirstAgentParticipantId + 109);
+  EXPECT_LE(agent_participant_id(128, 115), kMaxParticipantId);
+  EXPECT_EQ(agent_participant_id(128, 127), -1);  // beyond dds.participant_id's range
+}
