@@ -1,0 +1,81 @@
+#include "common/dds_config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "common/config_error.hpp"
+
+namespace ddswarm {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A directory holding what scripts/make-certs writes for one role (empty files).
+class SecureDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir = fs::temp_directory_path() / ("ddswarm-dds-config-test-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    for (const char* f : {"identity_ca.cert.pem", "permissions_ca.cert.pem", "governance.p7s",
+                          "agent-2.permissions.p7s", "agent-2.cert.pem", "agent-2.key.pem"})
+      std::ofstream(dir / f) << "x";
+  }
+  void TearDown() override { fs::remove_all(dir); }
+  DdsConfig secure(const std::string& role) {
+    DdsConfig c;
+    c.security_dir = dir.string();
+    c.security_role = role;
+    return c;
+  }
+  fs::path dir;
+};
+
+TEST_F(SecureDir, OffByDefault) {
+  DdsConfig c;
+  EXPECT_FALSE(c.secure());
+  EXPECT_NO_THROW(c.validate());
+}
+
+TEST_F(SecureDir, CompleteRoleValidates) {
+  auto c = secure("agent-2");
+  EXPECT_TRUE(c.secure());
+  EXPECT_NO_THROW(c.validate());
+  auto files = c.security_files();
+  ASSERT_EQ(files.size(), 6u);
+  EXPECT_EQ(fs::path(files[3]).filename(), "agent-2.permissions.p7s");
+  EXPECT_EQ(fs::path(files[5]).filename(), "agent-2.key.pem");
+}
+
+TEST_F(SecureDir, MissingFilesAreNamedInOneLine) {
+  auto c = secure("agent-3");
+  try {
+    c.validate();
+    FAIL() << "missing credentials accepted";
+  } catch (const FieldError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.field(), "dds.secure");
+    EXPECT_NE(what.find("agent-3.permissions.p7s, agent-3.cert.pem, agent-3.key.pem"), std::string::npos) << what;
+    EXPECT_EQ(what.find("identity_ca"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+TEST_F(SecureDir, BadOrMissingRoleRejected) {
+  EXPECT_THROW(secure("").validate(), FieldError);
+  EXPECT_THROW(secure("../agent-2").validate(), FieldError);
+}
+
+TEST(DdsConfigSecurity, DefaultRoleKeepsTheUsersChoice) {
+  DdsConfig c;
+  default_security_role(c, "server");
+  EXPECT_EQ(c.security_role, "server");
+  default_security_role(c, "gs");
+  EXPECT_EQ(c.security_role, "server");
+  EXPECT_EQ(drone_partition(7), "drone/7");
+}
+
+}  // namespace
+}  // namespace ddswarm
