@@ -16,10 +16,11 @@ const ROTOR_ANGLE = [-45, 135, 45, -135].map((d) => (d * Math.PI) / 180);
 const ROTOR_SPIN = [1, 1, -1, -1];   // +1: counter-clockwise seen from above
 export const SPIN_SCALE = 0.045;     // drawn rad/s per real rad/s (500 rad/s -> ~3.6 turns/s)
 
-// Trails: at most TRAIL_BUDGET segments in all (every one costs vertex work
-// each frame), up to 480 points a drone, a point every 0.25 s of sim time or
-// more, so that a trail spans at least 60 s.
-const TRAIL_BUDGET = 16384;
+// Trails: at most TRAIL_BUDGET segments in all (every one costs vertex and
+// line work each frame: on SwiftShader 16k segments cost as much as the
+// drones), up to 480 points a drone, a point every 0.25 s of sim time or more
+// so that a trail spans at least 30 s (120 s for a few drones).
+const TRAIL_BUDGET = 6144;
 const TRAIL_MAX_SLOTS = 480;
 const TRAIL_LIFE = 120;              // s of sim time a trail point stays visible
 const FLASH_MS = 900;
@@ -212,7 +213,7 @@ export class Drones {
 
     // Trails: slot k of drone i is segment (k * n + i): two vertices.
     this.trailSlots = Math.max(32, Math.min(TRAIL_MAX_SLOTS, Math.floor(TRAIL_BUDGET / n)));
-    this.trailDt = Math.max(0.25, 60 / this.trailSlots);
+    this.trailDt = Math.max(0.25, 30 / this.trailSlots);
     this.trailFilled = 0;
     const tv = this.trailSlots * n * 2;
     const tg = new THREE.BufferGeometry();
