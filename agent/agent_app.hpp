@@ -1,8 +1,12 @@
 #pragma once
 // The agent process: one drone's brain. It turns what it receives over DDS
 // (its state and scan, peers, mission commands) into a velocity command.
+// An agent host runs many drones' brains in one process (one participant,
+// one SwarmState sample per tick for all of them); each brain still sees only
+// what its drone would receive and keeps its own mission and peer state.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "agent/agent_config.hpp"
 #include "agent/comm_config.hpp"
@@ -17,7 +21,9 @@ struct AgentAppConfig {
   AgentConfig agent;
   CommConfig comm;
   DdsConfig dds;
-  int drone_id = 0;              ///< which drone this agent flies, [0, scenario.drones)
+  /// The drones this process flies, each in [0, scenario.drones): one (the
+  /// usual agent process) or many (an agent host, `--ids 0-511`).
+  std::vector<int> drone_ids{0};
   double duplicate_probe_s = 1.0;///< s wall: listen for another agent on this id before flying
   void validate() const;
 };

@@ -1,4 +1,5 @@
-// ddswarm-agent: the brain of one drone, a process of its own.
+// ddswarm-agent: the brain of one drone, a process of its own; or, with
+// --ids, an agent host flying many drones' independent brains in one process.
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
@@ -7,17 +8,21 @@
 #include "agent/agent_app.hpp"
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
+#include "common/id_ranges.hpp"
 #include "common/process.hpp"
 
 int main(int argc, char** argv) {
   return ddswarm::run_main("ddswarm-agent", [&] {
     CLI::App app{"ddswarm-agent: flies one drone by repulsion-attraction and obstacle avoidance"};
     std::string config;
-    int id = -1;
+    std::optional<int> id;
+    std::string ids_text;
     double duration_s = 0;
     std::optional<int> drones;
     ddswarm::DdsConfig dds_cli;
-    app.add_option("--id", id, "drone id to fly")->required();
+    auto* id_opt = app.add_option("--id", id, "drone id to fly");
+    app.add_option("--ids", ids_text, "agent host: fly these drones in this process, e.g. 0-511 or 3-5,7")
+        ->excludes(id_opt);
     app.add_option("--config,config", config, "scenario YAML (its agent: section)")->required();
     app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = until Ctrl-C)")
         ->check(ddswarm::finite_range(0.0, 1e9));
@@ -28,15 +33,29 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
       return app.exit(e) == 0 ? 0 : 2;
     }
+    if (!id && ids_text.empty()) {
+      std::fprintf(stderr, "ddswarm-agent: error: --id or --ids is required\n");
+      return 2;
+    }
     auto cfg = ddswarm::agent::load_agent_config(config);
-    cfg.drone_id = id;
     if (drones) cfg.scenario.drones = *drones;
-    if (id < 0 || id >= cfg.scenario.drones)
-      throw ddswarm::ConfigError(config + ": --id = " + std::to_string(id) + ": must be in [0, " +
-                                 std::to_string(cfg.scenario.drones - 1) + "] (scenario.drones = " +
-                                 std::to_string(cfg.scenario.drones) + ")");
+    if (id) {
+      if (*id < 0 || *id >= cfg.scenario.drones)
+        throw ddswarm::ConfigError(config + ": --id = " + std::to_string(*id) + ": must be in [0, " +
+                                   std::to_string(cfg.scenario.drones - 1) + "] (scenario.drones = " +
+                                   std::to_string(cfg.scenario.drones) + ")");
+      cfg.drone_ids = {*id};
+    } else {
+      try {
+        cfg.drone_ids = ddswarm::parse_id_ranges(ids_text, cfg.scenario.drones);
+      } catch (const std::invalid_argument& e) {
+        throw ddswarm::ConfigError(config + ": " + e.what() + " (scenario.drones = " +
+                                   std::to_string(cfg.scenario.drones) + ")");
+      }
+    }
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
-    ddswarm::default_security_role(cfg.dds, "agent-" + std::to_string(id));
+    ddswarm::default_security_role(
+        cfg.dds, cfg.drone_ids.size() == 1 ? "agent-" + std::to_string(cfg.drone_ids[0]) : "agent-host");
     cfg.validate();
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
     ddswarm::install_stop_signals();

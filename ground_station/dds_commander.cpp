@@ -37,6 +37,7 @@ struct AgentSeen {
   double d_int = 0;
   Phase phase = Phase::kIdle;
   std::uint64_t rejected = 0;  // AgentStatus.rejected_samples
+  std::string process;         // host:pid of the agent process flying it
 };
 }  // namespace
 
@@ -94,6 +95,7 @@ struct DdsCommander::Impl {
       s.wall = wall_seconds();
       s.d_int = a.inter_distance_m();
       s.phase = static_cast<Phase>(a.phase());
+      s.process = a.host().to_string() + ":" + std::to_string(a.pid());
       s.rejected = a.rejected_samples();
       cv.notify_all();
     });
@@ -142,8 +144,14 @@ struct DdsCommander::Impl {
 
   /// The server hears our commands and every online agent's acks reach us. mu held.
   bool all_matched() const {
-    return w_mission.matched() > 0 &&
-           ack_reader->matched() >= static_cast<int>(online_locked().size());
+    // One ack writer per agent process; an agent host flies many drones.
+    std::set<std::string> processes;
+    for (int id : online_locked()) {
+      auto it = agents.find(id);
+      processes.insert(it != agents.end() && !it->second.process.empty() ? it->second.process
+                                                                          : "drone " + std::to_string(id));
+    }
+    return w_mission.matched() > 0 && ack_reader->matched() >= static_cast<int>(processes.size());
   }
 
   CommandResult send(MissionCommand c) {

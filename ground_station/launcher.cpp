@@ -223,40 +223,6 @@ std::vector<ChildExit> Launcher::stop_all(double grace_s) {
   return out;
 }
 
-std::vector<int> parse_id_ranges(const std::string& text, int max_exclusive) {
-  std::vector<int> ids;
-  std::stringstream ss(text);
-  std::string part;
-  auto bad = [&](const std::string& why) {
-    throw std::invalid_argument("--ids " + text + ": " + why);
-  };
-  while (std::getline(ss, part, ',')) {
-    if (part.empty()) bad("empty range");
-    auto dash = part.find('-');
-    try {
-      std::size_t used = 0;
-      int a = std::stoi(part.substr(0, dash), &used);
-      if (used != (dash == std::string::npos ? part.size() : dash)) bad("not a number: " + part);
-      int b = a;
-      if (dash != std::string::npos) {
-        b = std::stoi(part.substr(dash + 1), &used);
-        if (used != part.size() - dash - 1) bad("not a number: " + part);
-      }
-      if (a > b) bad("range " + part + " runs backwards");
-      if (a < 0 || b >= max_exclusive)
-        bad("ids must be in [0, " + std::to_string(max_exclusive - 1) + "]");
-      for (int i = a; i <= b; ++i) ids.push_back(i);
-    } catch (const std::invalid_argument& e) {
-      if (std::string(e.what()).rfind("--ids", 0) == 0) throw;
-      bad("not a number: " + part);
-    } catch (const std::out_of_range&) {
-      bad("number too large: " + part);
-    }
-  }
-  if (ids.empty()) bad("no ids");
-  return ids;
-}
-
 DiscoveryServerChoice parse_discovery_server(const std::string& text) {
   DiscoveryServerChoice c;
   if (text == "auto") return c;

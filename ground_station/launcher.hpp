@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "common/id_ranges.hpp"
+
 namespace ddswarm::gs {
 
 struct ChildSpec {
@@ -70,8 +72,7 @@ class Launcher {
   std::thread pump_;
 };
 
-/// Parses "3-5,7" into {3,4,5,7}; throws std::invalid_argument naming the text.
-std::vector<int> parse_id_ranges(const std::string& text, int max_exclusive);
+using ddswarm::parse_id_ranges;  // common/id_ranges.hpp
 
 /// The launcher's --discovery-server: whether it runs a Fast DDS discovery
 /// server for the swarm, or points every child at one elsewhere.
