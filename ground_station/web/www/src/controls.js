@@ -101,7 +101,9 @@ export class Controls {
     const s = num('i-tspeed');
     const v = [0, 0, 0];
     for (const k of this.keys) for (let i = 0; i < 3; i++) v[i] += KEYS[k][i];
-    for (let i = 0; i < 3; i++) v[i] = Math.max(-1, Math.min(1, v[i])) * s;
+    for (let i = 0; i < 3; i++) v[i] = Math.max(-1, Math.min(1, v[i]));
+    const h = Math.hypot(v[0], v[1]) || 1;  // diagonals at the set speed, not 1.4 times it
+    v[0] = (v[0] / h) * s; v[1] = (v[1] / h) * s; v[2] *= s;
     if (v.every((x, i) => x === this.lastTeleop[i])) return;
     this.lastTeleop = v;
     this.send('teleop', { v }, `teleop (${v.map((x) => x.toFixed(1)).join(', ')}) m/s`);
