@@ -27,6 +27,10 @@ int main(int argc, char** argv) {
     app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = until Ctrl-C)")
         ->check(ddswarm::finite_range(0.0, 1e9));
     app.add_option("--drones", drones, "override scenario.drones");
+    double probe_s = 1.0;
+    app.add_option("--duplicate-probe", probe_s,
+                   "s to listen for another agent flying the same drone before flying (0 = trust the launcher)")
+        ->check(ddswarm::finite_range(0.0, 60.0));
     ddswarm::add_dds_options(app, dds_cli);
     try {
       app.parse(argc, argv);
@@ -53,6 +57,7 @@ int main(int argc, char** argv) {
                                    std::to_string(cfg.scenario.drones) + ")");
       }
     }
+    cfg.duplicate_probe_s = probe_s;
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
     ddswarm::default_security_role(
         cfg.dds, cfg.drone_ids.size() == 1 ? "agent-" + std::to_string(cfg.drone_ids[0]) : "agent-host");

@@ -6,6 +6,10 @@
 #include <filesystem>
 #include <fstream>
 #include <thread>
+#include <atomic>
+#include <mutex>
+#include <optional>
+#include <vector>
 
 #include "common/process.hpp"
 #include "ground_station/launcher.hpp"
@@ -72,33 +76,58 @@ std::string clock(double s) {
 
 }  // namespace
 
+namespace {
+
+/// One run, planned before any starts (its seeded scenario file written).
+struct RunPlan {
+  std::size_t set = 0;
+  int k = 0;
+  std::string tag, scenario_file;
+  RunRecord rec;
+  TaskConfig task;
+};
+
+/// Where one run's wall time went.
+struct RunTimes {
+  double startup_s = 0;   ///< processes started until every agent is online and matched
+  double flight_s = 0;    ///< takeoff until the task's result
+  double teardown_s = 0;  ///< stopping every process
+};
+
+}  // namespace
+
 int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, std::ostream& out) {
   const std::string bin = opt.bin_dir.empty() ? Launcher::self_dir() : opt.bin_dir;
   fs::create_directories(opt.out_dir + "/runs");
   const std::string csv = opt.out_dir + "/" + slug(cfg.name) + ".csv";
   if (fs::exists(csv)) fs::remove(csv);  // a fresh experiment; older rows would mix in
   const int total = static_cast<int>(cfg.sets.size()) * cfg.runs_per_set;
+  const int jobs = std::max(1, std::min(opt.jobs, total));
+  if (opt.dds.domain_id + jobs - 1 > 232)
+    throw std::invalid_argument(fmt::format("--jobs {}: runs use domains {}..{}, past DDS's 232", jobs,
+                                            opt.dds.domain_id, opt.dds.domain_id + jobs - 1));
   const double t0 = wall_seconds();
-  int done = 0, failed = 0;
-  std::vector<RunRecord> records;
-  out << fmt::format("experiment '{}': {} sets x {} runs, {} mode, results in {}\n", cfg.name,
-                     cfg.sets.size(), cfg.runs_per_set, cfg.mode, opt.out_dir);
-  for (std::size_t s = 0; s < cfg.sets.size() && !stop_requested(); ++s) {
+
+  std::vector<RunPlan> plans;
+  for (std::size_t s = 0; s < cfg.sets.size(); ++s) {
     YAML::Node base = scenario_for_set(cfg, s);
-    for (int k = 0; k < cfg.runs_per_set && !stop_requested(); ++k) {
+    for (int k = 0; k < cfg.runs_per_set; ++k) {
+      RunPlan p;
+      p.set = s;
+      p.k = k;
       YAML::Node sc = YAML::Clone(base);
       const std::uint64_t seed = cfg.seed(static_cast<int>(s), k);
       sc["scenario"]["seed"] = seed;
       sc["scenario"]["mode"] = cfg.mode;
       sc["sim"]["task_timeout_s"] = cfg.timeout_s;
-      const std::string tag = fmt::format("{}-{:02d}", slug(cfg.sets[s].name), k);
-      const std::string scenario_file = opt.out_dir + "/runs/" + tag + ".yaml";
+      p.tag = fmt::format("{}-{:02d}", slug(cfg.sets[s].name), k);
+      p.scenario_file = opt.out_dir + "/runs/" + p.tag + ".yaml";
       {
-        std::ofstream f(scenario_file);
+        std::ofstream f(p.scenario_file);
         f << YAML::Dump(sc) << "\n";
-        if (!f) throw std::runtime_error("cannot write " + scenario_file);
+        if (!f) throw std::runtime_error("cannot write " + p.scenario_file);
       }
-      RunRecord rec;
+      RunRecord& rec = p.rec;
       rec.set_name = cfg.sets[s].name;
       rec.run_index = k;
       rec.seed = seed;
@@ -106,73 +135,112 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       rec.drones = node_or<int>(sc, {"scenario", "drones"}, 6);
       rec.d_int_m = node_or<double>(sc, {"agent", "inter_distance_m"}, 4.0);
       rec.sensor_function = node_or<std::string>(sc, {"agent", "sensor_function", "type"}, "fs1");
-      TaskConfig task;
-      task.speed_mps = node_or<double>(sc, {"task", "speed_mps"}, task.speed_mps);
-      task.epsilon_m = node_or<double>(sc, {"task", "epsilon_m"}, task.epsilon_m);
-      rec.speed_mps = task.speed_mps;
+      p.task.speed_mps = node_or<double>(sc, {"task", "speed_mps"}, p.task.speed_mps);
+      p.task.epsilon_m = node_or<double>(sc, {"task", "epsilon_m"}, p.task.epsilon_m);
+      rec.speed_mps = p.task.speed_mps;
       for (const auto& [key, value] : cfg.sets[s].overrides) rec.params[key] = YAML::Dump(value);
-
-      const double run_start = wall_seconds();
-      out << fmt::format("run {} of {} ({} #{}, seed {}), elapsed {}", done + 1, total,
-                         cfg.sets[s].name, k + 1, seed, clock(run_start - t0));
-      if (done > 0)
-        out << fmt::format(", ETA {}", clock((run_start - t0) / done * (total - done)));
-      out << std::endl;
-
-      TaskOutcome o;
-      std::string died;
-      {
-        Launcher procs(opt.out_dir + "/logs/" + tag);
-        auto common_args = [&](std::vector<std::string> a) {
-          a.push_back("--domain");
-          a.push_back(std::to_string(opt.dds.domain_id));
-          if (opt.dds.secure()) {  // each child takes its own role's identity
-            a.push_back("--secure");
-            a.push_back(opt.dds.security_dir);
-          }
-          return a;
-        };
-        if (!opt.record_dir.empty()) {
-          fs::create_directories(opt.record_dir);
-          procs.start({"record", common_args({bin + "/ddswarm-record", "-o",
-                                              opt.record_dir + "/" + tag + ".mcap"})});
-        }
-        procs.start({"sim", common_args({bin + "/ddswarm-sim", "--scenario", scenario_file})});
-        for (int i = 0; i < rec.drones; ++i)
-          procs.start({"agent " + std::to_string(i),
-                       common_args({bin + "/ddswarm-agent", "--id", std::to_string(i), "--config",
-                                    scenario_file})});
-        DdsCommander gs(opt.gs, opt.dds);
-        // The sim-time limit per run: the task fails after cfg.timeout_s of sim time.
-        std::atomic<bool> finished{false};
-        std::thread watchdog([&] {
-          while (!finished && !stop_requested()) {
-            for (const auto& e : procs.reap()) died += (died.empty() ? "" : "; ") + e.describe();
-            std::this_thread::sleep_for(std::chrono::milliseconds(100));
-          }
-        });
-        o = fly_task(gs, rec.drones, task, nullptr);
-        finished = true;
-        watchdog.join();
-        procs.stop_all(3.0);
-      }
-      rec.ok = o.ok && died.empty();
-      rec.failure_reason = !died.empty() ? died : o.reason;
-      rec.task_time_s = o.ok ? o.task_time_s : std::nan("");
-      rec.wall_time_s = wall_seconds() - run_start;
-      rec.collisions_obstacle = o.collisions_obstacle;
-      rec.collisions_drone = o.collisions_drone;
-      rec.collisions_ground = o.collisions_ground;
-      rec.min_inter_drone_m = o.min_inter_drone_m;
-      rec.min_clearance_m = o.min_clearance_m;
-      append_csv(csv, rec);
-      records.push_back(rec);
-      ++done;
-      if (!rec.ok) ++failed;
-      out << "  " << (rec.ok ? o.line() : "FAILED: " + rec.failure_reason) << std::endl;
+      plans.push_back(std::move(p));
     }
   }
-  auto summary = summarize(records);
+
+  out << fmt::format("experiment '{}': {} sets x {} runs, {} mode, {} at a time, results in {}\n", cfg.name,
+                     cfg.sets.size(), cfg.runs_per_set, cfg.mode, jobs, opt.out_dir);
+  std::mutex mu;  // out, the counters and the records below
+  int started = 0, done = 0, failed = 0;
+  std::vector<std::optional<RunRecord>> records(plans.size());
+  RunTimes sum;
+  std::atomic<int> next{0};
+
+  // One run, on its own DDS domain (one per parallel job): fresh processes,
+  // every one of them stopped before it returns.
+  auto run_one = [&](RunPlan& p, int domain) {
+    RunRecord rec = p.rec;
+    RunTimes times;
+    const double run_start = wall_seconds();
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      ++started;
+      out << fmt::format("run {} of {} ({} #{}, seed {}), elapsed {}", started, total, rec.set_name,
+                         p.k + 1, rec.seed, clock(run_start - t0));
+      if (done > 0) out << fmt::format(", ETA {}", clock((run_start - t0) / done * (total - done)));
+      out << std::endl;
+    }
+    TaskOutcome o;
+    std::string died;
+    {
+      Launcher procs(opt.out_dir + "/logs/" + p.tag);
+      auto common_args = [&](std::vector<std::string> a) {
+        a.push_back("--domain");
+        a.push_back(std::to_string(domain));
+        if (opt.dds.secure()) {  // each child takes its own role's identity
+          a.push_back("--secure");
+          a.push_back(opt.dds.security_dir);
+        }
+        return a;
+      };
+      if (!opt.record_dir.empty()) {
+        fs::create_directories(opt.record_dir);
+        procs.start({"record", common_args({bin + "/ddswarm-record", "-o",
+                                            opt.record_dir + "/" + p.tag + ".mcap"})});
+      }
+      procs.start({"sim", common_args({bin + "/ddswarm-sim", "--scenario", p.scenario_file})});
+      for (int i = 0; i < rec.drones; ++i)
+        procs.start({"agent " + std::to_string(i),
+                     common_args({bin + "/ddswarm-agent", "--id", std::to_string(i), "--config",
+                                  p.scenario_file, "--duplicate-probe", "0.2"})});
+      DdsConfig dds = opt.dds;
+      dds.domain_id = domain;
+      DdsCommander gs(opt.gs, dds);
+      // The sim-time limit per run: the task fails after cfg.timeout_s of sim time.
+      std::atomic<bool> finished{false};
+      std::thread watchdog([&] {
+        while (!finished && !stop_requested()) {
+          for (const auto& e : procs.reap()) died += (died.empty() ? "" : "; ") + e.describe();
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+      });
+      gs.wait_for_swarm(rec.drones, 30.0);  // fly_task says so if it failed
+      const double flight_start = wall_seconds();
+      times.startup_s = flight_start - run_start;
+      o = fly_task(gs, rec.drones, p.task, nullptr);
+      times.flight_s = wall_seconds() - flight_start;
+      finished = true;
+      watchdog.join();
+      const double stop_start = wall_seconds();
+      procs.stop_all(3.0);
+      times.teardown_s = wall_seconds() - stop_start;
+    }
+    rec.ok = o.ok && died.empty();
+    rec.failure_reason = !died.empty() ? died : o.reason;
+    rec.task_time_s = o.ok ? o.task_time_s : std::nan("");
+    rec.wall_time_s = wall_seconds() - run_start;
+    rec.collisions_obstacle = o.collisions_obstacle;
+    rec.collisions_drone = o.collisions_drone;
+    rec.collisions_ground = o.collisions_ground;
+    rec.min_inter_drone_m = o.min_inter_drone_m;
+    rec.min_clearance_m = o.min_clearance_m;
+    std::lock_guard<std::mutex> lock(mu);
+    append_csv(csv, rec);
+    ++done;
+    if (!rec.ok) ++failed;
+    sum.startup_s += times.startup_s;
+    sum.flight_s += times.flight_s;
+    sum.teardown_s += times.teardown_s;
+    out << "  " << p.tag << ": " << (rec.ok ? o.line() : "FAILED: " + rec.failure_reason) << std::endl;
+    records[&p - plans.data()] = rec;
+  };
+
+  std::vector<std::thread> workers;
+  for (int w = 0; w < jobs; ++w)
+    workers.emplace_back([&, w] {
+      for (int i = next++; i < total && !stop_requested(); i = next++) run_one(plans[i], opt.dds.domain_id + w);
+    });
+  for (auto& t : workers) t.join();
+
+  std::vector<RunRecord> finished_records;
+  for (auto& r : records)
+    if (r) finished_records.push_back(*r);
+  auto summary = summarize(finished_records);
   const std::string table = markdown_table(summary);
   {
     std::ofstream f(opt.out_dir + "/" + slug(cfg.name) + ".md");
@@ -180,12 +248,20 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
   }
   out << "\n" << table << "\n";
   try {
-    write_plots(records, opt.out_dir + "/plots");
+    write_plots(finished_records, opt.out_dir + "/plots");
     out << "plots: " << opt.out_dir << "/plots\n";
   } catch (const std::exception& e) {
     out << "plots not written: " << e.what() << "\n";
   }
-  out << fmt::format("{} runs, {} failed, {} wall; CSV {}\n", done, failed, clock(wall_seconds() - t0), csv);
+  const double wall = wall_seconds() - t0;
+  const double busy = sum.startup_s + sum.flight_s + sum.teardown_s;
+  if (done > 0 && busy > 0)
+    out << fmt::format(
+        "wall time per run (summed over {} runs, {} at a time): start-up {:.1f} s ({:.0f} %), flight {:.1f} s "
+        "({:.0f} %), teardown {:.1f} s ({:.0f} %)\n",
+        done, jobs, sum.startup_s, 100 * sum.startup_s / busy, sum.flight_s, 100 * sum.flight_s / busy,
+        sum.teardown_s, 100 * sum.teardown_s / busy);
+  out << fmt::format("{} runs, {} failed, {} wall; CSV {}\n", done, failed, clock(wall), csv);
   return failed == 0 && done == total ? 0 : 1;
 }
 

@@ -23,10 +23,14 @@ struct ExperimentOptions {
   GroundStationConfig gs;
   std::string bin_dir;              ///< where ddswarm-sim / ddswarm-agent live (default: next to us)
   std::string record_dir;           ///< when set, each run's DDS traffic goes to <record_dir>/<run>.mcap
+  int jobs = 1;                     ///< runs at a time; job w uses DDS domain dds.domain_id + w
 };
 
-/// Runs every set's runs in order; returns 0 when every run completed, 1 when
-/// some failed (they are recorded with their reason), throws on setup errors.
+/// Runs every set's runs (jobs at a time, each on its own domain; a lockstep
+/// run's result does not depend on what else runs); returns 0 when every run
+/// completed, 1 when some failed (they are recorded with their reason),
+/// throws on setup errors. Prints how the wall time split between start-up,
+/// flight and teardown.
 int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, std::ostream& out);
 
 }  // namespace ddswarm::gs

@@ -161,6 +161,9 @@ int main(int argc, char** argv) {
     experiment->add_option("--out", out_dir, "output directory");
     std::string record_dir;
     experiment->add_option("--record", record_dir, "record each run's DDS traffic to DIR/<run>.mcap");
+    int jobs = 1;
+    experiment->add_option("--jobs", jobs, "runs at a time, each on its own DDS domain (--domain, --domain + 1, ...)")
+        ->check(CLI::Range(1, 16));
 
     try {
       app.parse(argc, argv);
@@ -185,6 +188,7 @@ int main(int argc, char** argv) {
       opt.dds = file.dds;
       opt.gs = file.gs;
       opt.record_dir = record_dir;
+      opt.jobs = jobs;
       return run_experiment(exp, opt, std::cout);
     }
 

@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Issue 4: a short experiment (2 sets x 2 runs, real multi-process lockstep
 # runs) produces a CSV, a Markdown table and plot files with the right counts.
+# Issue 8: run two at a time (--jobs 2, each on its own domain), it gives the
+# very same results, and it says where the wall time went.
 source "$(dirname "$0")/lib.sh"
 out="$WORK/results"
+out2="$WORK/results2"
 timeout 400 "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out" \
   >"$WORK/experiment.log" 2>&1
 rc=$?
@@ -19,4 +22,10 @@ svgs=$(ls "$out"/plots/*.svg 2>/dev/null | wc -l)
 [ "$pngs" -ge 3 ] && [ "$svgs" -ge 3 ] || fail "expected a PNG and an SVG per set plus the summary, found $pngs PNG, $svgs SVG"
 [ -s "$out/plots/summary.png" ] || fail "no summary plot"
 ls "$out"/runs/*.yaml | wc -l | grep -qx 4 || fail "expected 4 per-run scenarios"
+grep -Eq "wall time per run .*start-up .*flight .*teardown" "$WORK/experiment.log" || fail "no wall-time split"
+timeout 400 "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out2" \
+  --jobs 2 >"$WORK/experiment2.log" 2>&1 || { cat "$WORK/experiment2.log"; fail "experiment --jobs 2 failed"; }
+tail -3 "$WORK/experiment2.log"
+results() { awk -F, 'NR > 1 { print $1, $2, $3, $9, $11, $13, $14, $15, $16 }' "$1" | sort; }
+diff <(results "$out/short.csv") <(results "$out2/short.csv") || fail "two at a time gave other results"
 echo PASS
