@@ -8,7 +8,7 @@
 # and the real agent binary started for drone 3 with agent-2's identity
 # cannot fly it.
 source "$(dirname "$0")/lib.sh"
-scenario="$SRC/tests/scenarios/slow_liveness.yaml"
+scenario="$SRC/tests/scenarios/secure_small.yaml"
 C="$WORK/certs"
 "$SRC/scripts/make-certs" --out "$C" --agents 4 --domain "$DOMAIN" || fail "make-certs failed"
 gs() { timeout 40 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" --secure "$C" "$@"; }
@@ -30,13 +30,13 @@ echo "$out" | grep -q "writer refused" || fail "agent-2's identity got a writer 
 n0=$(impostors); p0=$(xy 3)
 [ -n "$n0" ] && [ -n "$p0" ] || fail "no status from the server"
 out=$("$BIN/secure_probe" --domain "$DOMAIN" --secure "$C" --security-role agent-2 --publish velocity \
-  --drone 3 --partition drone/2 --spoof --east 2 --for 4); echo "$out"
+  --drone 3 --partition drone/2 --spoof --east 2 --wait-match 20 --for 4); echo "$out"
 echo "$out" | grep -q "writer created matched=[1-9].* heard_heartbeats=[1-9]" ||
   fail "agent-2's identity did not reach the server on its own channel (the attack was not tried)"
 n1=$(impostors); p1=$(xy 3)
 d=$(moved "$p0" "$p1")
 echo "impostor commands counted: $n0 -> $n1; drone 3 moved $d m while agent-2 commanded it 2 m/s east for 4 s"
-[ $((n1 - n0)) -ge 100 ] || fail "the server did not count agent-2's commands for drone 3 as an impostor's"
+[ $((n1 - n0)) -ge 50 ] || fail "the server did not count agent-2's commands for drone 3 as an impostor's"
 awk -v d="$d" 'BEGIN { exit !(d < 0.3) }' || fail "drone 3 moved under agent-2's commands ($p0 -> $p1)"
 
 # The agent binary for drone 3 with agent-2's identity stops with a clear error.

@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
     int drone = 0;
     std::optional<std::string> partition;
     bool spoof = false;
-    double for_s = 3.0, east_mps = 2.0;
+    double for_s = 3.0, east_mps = 2.0, wait_match_s = 0;
     add_dds_options(app, dds);
     app.add_option("--publish", what, "velocity | swarm_state")->check(CLI::IsMember({"velocity", "swarm_state"}));
     app.add_option("--drone", drone, "velocity: the drone addressed");
@@ -42,6 +42,10 @@ int main(int argc, char** argv) {
     app.add_flag("--spoof", spoof, "velocity: carry the drone's live agent instance and the current tick");
     app.add_option("--east", east_mps, "velocity: m/s east in every command");
     app.add_option("--for", for_s, "wall seconds to publish and listen");
+    app.add_option("--wait-match", wait_match_s,
+                   "first wait up to this many wall seconds for a matched reader (with --spoof, also the "
+                   "drone's heartbeat; when refused, a swarm state), so a slow authentication does not "
+                   "shorten the attack");
     CLI11_PARSE(app, argc, argv);
     install_stop_signals();
 
@@ -73,7 +77,15 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "probe: %s\n", e.what());
       refused = true;
     }
-    // Give authentication and discovery their time before judging.
+    const double w0 = wall_seconds();
+    auto ready = [&] {
+      std::lock_guard<std::mutex> lock(mu);
+      if (refused) return heard_state > 0;  // nothing to match: wait until it hears the swarm
+      const int m = w_cmd ? w_cmd->matched() : w_state->matched();
+      return m > 0 && (!spoof || owner != 0);
+    };
+    while (!stop_requested() && wall_seconds() - w0 < wait_match_s && !ready())
+      wait_for_stop(std::chrono::milliseconds(20));
     const double t0 = wall_seconds();
     int matched = 0;
     long sent = 0;

@@ -4,7 +4,7 @@
 # A participant without credentials sees no topic and cannot move a drone;
 # the recorder's identity is refused a writer.
 source "$(dirname "$0")/lib.sh"
-scenario="$SRC/tests/scenarios/slow_liveness.yaml"  # 3 drones, real time
+scenario="$SRC/tests/scenarios/secure_small.yaml"  # 3 drones, real time
 C="$WORK/certs"
 "$SRC/scripts/make-certs" --out "$C" --agents 3 --domain "$DOMAIN" || fail "make-certs failed"
 gs() { timeout 40 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" --secure "$C" "$@"; }
@@ -24,7 +24,7 @@ d=$(moved "$p0" "$p1"); echo "drone 0 moved $d m north under the authenticated g
 awk -v d="$d" 'BEGIN { exit !(d > 1.0) }' || fail "drone 0 did not move ($p0 -> $p1)"
 
 # No credentials: the ground station finds no server ...
-out=$(timeout 30 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" status 2>&1); rc=$?
+out=$(timeout 30 "$BIN/ddswarm-gs" --domain "$DOMAIN" status 2>&1); rc=$?
 echo "$out"
 [ $rc -eq 1 ] && echo "$out" | grep -q "no simulation server" ||
   fail "a ground station without credentials saw the server (exit $rc)"
@@ -39,7 +39,7 @@ d=$(moved "$p1" "$p2"); echo "drone 0 moved $d m while commanded 2 m/s east for 
 awk -v d="$d" 'BEGIN { exit !(d < 0.3) }' || fail "drone 0 moved under an unauthenticated command ($p1 -> $p2)"
 
 # The recorder's identity reads but may not write.
-out=$("$BIN/secure_probe" --domain "$DOMAIN" --secure "$C" --security-role recorder --publish swarm_state --for 2)
+out=$("$BIN/secure_probe" --domain "$DOMAIN" --secure "$C" --security-role recorder --publish swarm_state --wait-match 20 --for 1)
 echo "$out"
 echo "$out" | grep -q "writer refused matched=0 sent=0 heard_state=[1-9]" ||
   fail "the recorder's identity was allowed a SwarmState writer, or heard nothing"
