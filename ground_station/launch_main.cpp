@@ -86,6 +86,10 @@ int main(int argc, char** argv) {
     app.add_option("--seed", seed, "scenario seed");
     app.add_option("--only", only, "start only: server | agents | all")->check(CLI::IsMember({"server", "agents", "all"}));
     app.add_option("--ids", ids_text, "agents to start, e.g. 3-5,7 (default: all)");
+    int agent_hosts = 0;
+    app.add_option("--agent-hosts", agent_hosts,
+                   "fly the agents in K agent-host processes (ddswarm-agent --ids) instead of one process per drone")
+        ->check(CLI::Range(1, 1024));
     app.add_option("--on-death", on_death,
                    "when a process dies: stop (stop everything, exit 1) | keep (report, keep flying)")
         ->check(CLI::IsMember({"stop", "keep"}));
@@ -162,7 +166,7 @@ int main(int argc, char** argv) {
       dds_args.push_back(ds.address);
     }
     for (const char* opt : {"--domain", "--dds-interface", "--dds-local-ip",
-                            "--dds-profiles", "--dds-peers"}) {
+                            "--dds-profiles", "--dds-peers", "--secure"}) {
       if (app.count(opt)) {
         auto* o = app.get_option(opt);
         dds_args.push_back(opt);
@@ -215,7 +219,19 @@ int main(int argc, char** argv) {
                                "ids, and past ~100 participants per host Fast DDS leaves them unreachable "
                                "(dds.participant_id stops at {}; docs/performance.md)\n",
                                n, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
-    for (int id : ids) {
+    // Agent hosts: K processes, each flying a contiguous share of the ids.
+    for (int h = 0; agent_hosts > 0 && h < agent_hosts && h < static_cast<int>(ids.size()); ++h) {
+      const std::size_t per = (ids.size() + agent_hosts - 1) / agent_hosts;
+      const std::size_t lo = h * per, hi = std::min(ids.size(), lo + per);
+      if (lo >= hi) break;
+      std::string share;
+      for (std::size_t k = lo; k < hi; ++k) share += (share.empty() ? "" : ",") + std::to_string(ids[k]);
+      std::vector<std::string> a = {bin + "/ddswarm-agent", "--ids", share, "--config", scenario, "--drones",
+                                    std::to_string(n)};
+      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      procs.start({"agent host " + std::to_string(h), a});
+    }
+    for (int id : agent_hosts > 0 ? std::vector<int>{} : ids) {
       std::vector<std::string> a = {bin + "/ddswarm-agent", "--id", std::to_string(id), "--config",
                                     scenario, "--drones", std::to_string(n)};
       a.insert(a.end(), dds_args.begin(), dds_args.end());

@@ -40,4 +40,9 @@ grep "task complete" "$WORK/host.result" || fail "host: no result"
 grep "task complete" "$WORK/procs.result" || fail "processes: no result"
 strip() { grep "task complete" "$1" | sed 's/(wall [0-9.]* s)//'; }
 [ "$(strip "$WORK/host.result")" = "$(strip "$WORK/procs.result")" ] || fail "the agent host and six processes disagree"
+# The launcher splits the swarm into agent hosts.
+timeout 120 "$BIN/ddswarm-launch" "$scenario" --mode lockstep --agent-hosts 2 --domain "$DOMAIN" --log-dir "$WORK/hosts" \
+  --gs "takeoff --wait; task" >"$WORK/hosts.result" 2>&1 || { cat "$WORK/hosts.result"; fail "launch --agent-hosts 2"; }
+grep -q "started 3 process(es)" "$WORK/hosts.result" || fail "expected the server and two agent hosts"
+[ "$(strip "$WORK/hosts.result")" = "$(strip "$WORK/procs.result")" ] || fail "two agent hosts and six processes disagree"
 echo PASS
