@@ -40,7 +40,9 @@ grep "task complete" "$WORK/host.result" || fail "host: no result"
 grep "task complete" "$WORK/procs.result" || fail "processes: no result"
 strip() { grep "task complete" "$1" | sed 's/(wall [0-9.]* s)//'; }
 [ "$(strip "$WORK/host.result")" = "$(strip "$WORK/procs.result")" ] || fail "the agent host and six processes disagree"
-# The launcher splits the swarm into agent hosts.
+# The launcher splits the swarm into agent hosts (the six processes go first).
+for i in 0 1 2 3 4 5; do pid_var="PID_p$i"; kill -TERM "${!pid_var}"; done
+for i in 0 1 2 3 4 5; do pid_var="PID_p$i"; wait_pid "${!pid_var}" 10 >/dev/null; done
 timeout 120 "$BIN/ddswarm-launch" "$scenario" --mode lockstep --agent-hosts 2 --domain "$DOMAIN" --log-dir "$WORK/hosts" \
   --gs "takeoff --wait; task" >"$WORK/hosts.result" 2>&1 || { cat "$WORK/hosts.result"; fail "launch --agent-hosts 2"; }
 grep -q "started 3 process(es)" "$WORK/hosts.result" || fail "expected the server and two agent hosts"
