@@ -39,6 +39,22 @@ const width = Number(a.width ?? 1280), height = Number(a.height ?? 720);
 const browser = await launch();
 let rc = 0;
 try {
+  // Reference: an empty WebGL page (a clear per frame) at the same size, for
+  // what this machine's load leaves to any page.
+  {
+    const page = await browser.newPage({ viewport: { width, height } });
+    await page.setContent(`<canvas id=c style="display:block;width:100vw;height:100vh"></canvas><script>
+      const c = document.getElementById('c'); c.width = innerWidth; c.height = innerHeight;
+      const gl = c.getContext('webgl2'); window.drawn = 0;
+      const f = () => { gl.clearColor(0.5, 0.6, 0.5, 1); gl.clear(gl.COLOR_BUFFER_BIT); window.drawn++; requestAnimationFrame(f); };
+      requestAnimationFrame(f);</script>`);
+    await page.waitForTimeout(2000);
+    const c0 = browserCpuMs(), d0 = await page.evaluate(() => window.drawn), t0 = Date.now();
+    await page.waitForTimeout(1000 * Math.min(seconds, 5));
+    const frames = (await page.evaluate(() => window.drawn)) - d0;
+    console.log(`fps empty  ${((frames * 1000) / (Date.now() - t0)).toFixed(1)}: an empty WebGL page, ${width}x${height}; browser CPU ${((browserCpuMs() - c0) / Math.max(1, frames)).toFixed(1)} ms per frame`);
+    await page.close();
+  }
   for (const q of levels) {
     const u = new URL(a.url);
     u.searchParams.set('quality', q);
