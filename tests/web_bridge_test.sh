@@ -79,6 +79,11 @@ head -c 5000 /dev/urandom >"$WORK/junk.mcap"
 out=$(wc_ upload "$port" "$WORK/junk.mcap" junk.mcap); rc=$?
 [ $rc -ne 0 ] && echo "$out" | grep -q '"error"' || fail "junk upload: rc $rc: $out"
 echo "junk upload: $out"
+# Uploads over Beast's default 1 MiB body limit reach our own checks (a 3 MB
+# non-MCAP is read whole and refused as such, not dropped mid-upload).
+head -c 3000000 /dev/urandom >"$WORK/big.mcap"
+out=$(wc_ upload "$port" "$WORK/big.mcap" big.mcap); rc=$?
+echo "$out" | grep -q '"error"' && ! echo "$out" | grep -q "limit" || fail "3 MB upload: rc $rc: $out"
 
 # Land through the page, then stop the bridge: SIGTERM, exit 0, counts in its last line.
 wc_ ws "$port" type=hello 'send={"type":"command","id":4,"cmd":"land"}' ack=4:ok close >/dev/null || fail "land"

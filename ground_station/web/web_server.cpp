@@ -383,6 +383,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void read() {
     header_.emplace();
     header_->header_limit(16 * 1024);
+    // The header parser enforces its own body limit (1 MiB by default) when it
+    // reads Content-Length: let uploads through to our --web-max-upload-mb check.
+    header_->body_limit(srv_.cfg.max_upload_bytes);
     stream_.expires_after(kHttpTimeout);
     http::async_read_header(stream_, buf_, *header_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
       if (ec) return self->close();
