@@ -210,11 +210,14 @@ fi
 if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   : >"$OUT/plot.dat"
   while read -r l; do
-    echo "$(field n "$l") $(field ticks_per_s "$l") $(field floor "$l")" >>"$OUT/plot.dat"
+    t=$(field ticks_per_s "$l"); f=$(field floor "$l")
+    echo "$(field n "$l") ${t:-?} ${f:-?}" | sed 's/nan/?/g' |
+      awk '{ for (i = 2; i <= 3; ++i) if ($i != "?") $i = $i / 50; print }' >>"$OUT/plot.dat"
   done <"$OUT/lockstep.txt"
   : >"$OUT/plot_rt.dat"
   [ -f "$OUT/realtime.txt" ] && while read -r l; do
-    echo "$(field n "$l") $(field rtf "$l")" >>"$OUT/plot_rt.dat"
+    r=$(field rtf "$l")
+    echo "$(field n "$l") ${r:-?}" >>"$OUT/plot_rt.dat"
   done <"$OUT/realtime.txt"
   gnuplot <<EOF
 set terminal pngcairo size 900,600 font ",11" noenhanced
@@ -223,12 +226,13 @@ set title "Real-time factor against swarm size (one process per drone, 2 cores)"
 set xlabel "drones (agent processes)"
 set ylabel "real-time factor (sim s per wall s, 50 Hz control)"
 set logscale xy
+set datafile missing "?"
 set xtics (6, 10, 16, 32, 64, 128)
 set xrange [4:180]
 set grid
 set key top right box opaque
-plot "$OUT/plot.dat" using 1:(\$3/50) with linespoints lw 2 title "bare Fast DDS floor (ticks/s / 50)", \
-     "$OUT/plot.dat" using 1:(\$2/50) with linespoints lw 2 title "ddswarm lockstep", \
+plot "$OUT/plot.dat" using 1:3 with linespoints lw 2 title "bare Fast DDS floor (ticks/s / 50)", \
+     "$OUT/plot.dat" using 1:2 with linespoints lw 2 title "ddswarm lockstep (ticks/s / 50)", \
      "$OUT/plot_rt.dat" using 1:2 with linespoints lw 2 title "ddswarm real time (paced, target 1)", \
      "-" using 1:2 with points pt 7 ps 1.6 title "gym-pybullet-drones: 10 at about 2x", \
      "-" using 1:2 with points pt 5 ps 1.6 title "SwarmLab: 16 at about 1x", \
