@@ -181,7 +181,9 @@ int main(int argc, char** argv) {
     Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
     const bool localhost_discovery = file.dds.discovery == Discovery::kLocalhost &&
                                      !app.count("--dds-interface") && !app.count("--dds-peers");
-    if (wants_local_discovery_server(ds, n, only == "all" && ids_text.empty(), localhost_discovery)) {
+    // What discovery scales with is participants: with agent hosts, a few.
+    const int participants = agent_hosts > 0 ? std::min<int>(agent_hosts, n) + 1 : n;
+    if (wants_local_discovery_server(ds, participants, only == "all" && ids_text.empty(), localhost_discovery)) {
       // First, so every participant finds it; clients retry until it answers.
       const int port = free_udp_port();
       procs.start(discovery_server_spec(port));
@@ -214,7 +216,7 @@ int main(int argc, char** argv) {
       a.insert(a.end(), dds_args.begin(), dds_args.end());
       procs.start({"sim", a});
     }
-    if (!ids.empty() && agent_participant_id(n, ids.back()) < 0 && n > kExplicitParticipantIdsAbove)
+    if (agent_hosts == 0 && !ids.empty() && agent_participant_id(n, ids.back()) < 0 && n > kExplicitParticipantIdsAbove)
       std::cerr << fmt::format("ddswarm-launch: warning: {} drones: agents past drone {} get automatic participant "
                                "ids, and past ~100 participants per host Fast DDS leaves them unreachable "
                                "(dds.participant_id stops at {}; docs/performance.md)\n",
