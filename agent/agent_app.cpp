@@ -132,6 +132,9 @@ struct AgentApp::Impl {
   double last_sample_wall = -1e9;
   bool server_lost = false;
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
+  // This tick's swarm members (live agent, not in failsafe, finite position),
+  // by id: converted once per sample for every brain in the process.
+  std::vector<PeerObservation> roster;
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
   ~Impl() { dds.close(); }
@@ -280,6 +283,19 @@ struct AgentApp::Impl {
     }
     have_tick = true;
     last_tick = s.tick();
+    roster.clear();
+    for (const auto& d : s.drones()) {
+      // A drone without a live agent (lost: the server's failsafe flies it,
+      // hovering then landing) is no member of the swarm: no attraction to
+      // it, or the swarm would stay tied to a wreck. The distance sensors
+      // still see it as an obstacle.
+      if (!(d.flags() & msg::DRONE_AGENT_LIVE) || (d.flags() & msg::DRONE_FAILSAFE)) continue;
+      if (!finite(d.position())) {
+        ++rejected;
+        continue;
+      }
+      roster.push_back({d.drone_id(), from_msg(d.position()), d.sim_time_s()});
+    }
     for (const auto& b : brains) answer(*b, s);
   }
 
@@ -346,19 +362,8 @@ struct AgentApp::Impl {
     }
 
     b.others.clear();
-    for (const auto& d : s.drones()) {
-      if (d.drone_id() == id) continue;
-      // A drone without a live agent (lost: the server's failsafe flies it,
-      // hovering then landing) is no member of the swarm: no attraction to
-      // it, or the swarm would stay tied to a wreck. The distance sensors
-      // still see it as an obstacle.
-      if (!(d.flags() & msg::DRONE_AGENT_LIVE) || (d.flags() & msg::DRONE_FAILSAFE)) continue;
-      if (!finite(d.position())) {
-        ++b.rejected;
-        continue;
-      }
-      b.others.push_back({d.drone_id(), from_msg(d.position()), d.sim_time_s()});
-    }
+    for (const auto& o : roster)
+      if (o.id != id) b.others.push_back(o);
     // Each tick's truth and beacons go to the peer source once, even when the
     // server re-sends the same tick while it waits.
     const bool new_tick = s.tick() != b.fed_tick;
