@@ -89,7 +89,7 @@ struct DroneBrain {
   std::uint32_t last_mission_seq = 0;
   bool caught_up = false;  // the mission in force (the ring) was taken from the first sample
   std::uint64_t rejected = 0, sent = 0;
-  std::uint64_t rival = 0;  // another instance heard on this id
+  std::uint64_t rival = 0;  // another instance heard on this id during the start-up probe
   std::string rival_where;
   std::vector<PeerObservation> others;
   std::vector<Eigen::Vector3d> ranged;
@@ -159,7 +159,7 @@ struct AgentApp::Impl {
       brains.push_back(std::make_unique<DroneBrain>(id));
       by_id[id] = brains.back().get();
     }
-    dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& s, const fdds::SampleInfo&) {
+    auto& probe = dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& s, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
       auto it = by_id.find(s.drone_id());
       if (it == by_id.end() || s.agent_instance() == it->second->instance) return;
@@ -179,6 +179,10 @@ struct AgentApp::Impl {
           throw DuplicateAgent("drone " + std::to_string(b->id) + " is already flown by agent " +
                                fmt::format("{:016x}", b->rival) + " (" + b->rival_where + ")");
     }
+    // Every agent hearing every other's heartbeat is O(N^2) traffic: at 64
+    // agents it cost 1.7 cores of a paused swarm. After the probe, a rival is
+    // the server's business (it keeps the first owner and counts impostors).
+    dds.remove(probe);
     publish_status();
     dds.reader<msg::SwarmState>([this](const msg::SwarmState& s, const fdds::SampleInfo& info) {
       on_swarm(s, info.sample_identity.writer_guid().guidPrefix);
@@ -462,12 +466,6 @@ struct AgentApp::Impl {
           spdlog::warn("{}: no server samples for {:.1f} s; holding commands until it returns",
                        label, silent);
         }
-        for (const auto& b : brains)
-          if (b->rival) {
-            spdlog::warn("drone {}: another agent ({}) claims this drone; the server keeps the first",
-                         b->id, b->rival_where);
-            b->rival = 0;
-          }
       }
       wait_for_stop(std::chrono::milliseconds(250));
     }

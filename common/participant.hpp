@@ -119,6 +119,16 @@ class Participant {
     return ref;
   }
 
+  /// Deletes a reader made by reader() (waiting for a running callback):
+  /// its handler never runs again and its samples stop flowing to us.
+  template <class T>
+  void remove(Reader<T>& r) {
+    if (closed_ || !r.raw()) return;
+    fdds::DataReader* raw_reader = r.raw();
+    const_cast<fdds::Subscriber*>(raw_reader->get_subscriber())->delete_datareader(raw_reader);
+    r.attach(nullptr);
+  }
+
   fdds::DomainParticipant* raw() const { return participant_; }
   /// True when DDS Security is on (DdsConfig::security_dir).
   bool secure() const { return secure_; }
