@@ -60,6 +60,7 @@ struct DdsCommander::Impl {
   std::uint32_t task_seq = 0;
   double last_command_wall = -1e9;  // when the latest command was sent
   Reader<msg::MissionAck>* ack_reader = nullptr;
+  Reader<msg::TaskStatus>* task_reader = nullptr;
   std::optional<TaskOutcome> outcome;
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
@@ -84,7 +85,7 @@ struct DdsCommander::Impl {
       scene_seed = sc.seed();
       scene_name = sc.name().to_string();
     });
-    dds.reader<msg::TaskStatus>([this](const msg::TaskStatus& t, const fdds::SampleInfo&) {
+    task_reader = &dds.reader<msg::TaskStatus>([this](const msg::TaskStatus& t, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
       task = t;
       cv.notify_all();
@@ -336,7 +337,11 @@ CommandResult DdsCommander::task(double speed, double eps) {
 }
 
 bool DdsCommander::wait_task_status(double timeout_s) {
-  return impl_->wait(timeout_s, [&] { return impl_->task.has_value(); });
+  // Latched: once our reader has matched the server's writer, its last
+  // sample (if it ever wrote one) follows at once. Matching can lag the
+  // status sample on a loaded machine, so wait for the match first.
+  impl_->wait(timeout_s, [&] { return impl_->task.has_value() || impl_->task_reader->matched() > 0; });
+  return impl_->wait(1.0, [&] { return impl_->task.has_value(); });
 }
 
 bool DdsCommander::attach_task(double timeout_s) {

@@ -227,7 +227,7 @@ int main(int argc, char** argv) {
       return ok ? 0 : 1;
     }
     if (*status) {
-      gs.wait_task_status(0.5);  // latched: arrives right after the status when there is one
+      gs.wait_task_status(file.gs.discovery_timeout_s);  // latched: follows the match when there is one
       const SwarmStatus st = gs.status();
       std::printf("%s\n%s\n", format_status(st).c_str(), format_rejections(st).c_str());
       if (status_drones) {
