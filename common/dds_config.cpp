@@ -49,6 +49,8 @@ void load(YamlSection s, DdsConfig& c) {
   s.finish();
 }
 
+int max_participant_id(int domain_id) { return (65535 - 7400 - 11 - 250 * domain_id) / 2; }
+
 void DdsConfig::validate() const {
   if (FILE* f = std::fopen(profiles_file.c_str(), "r")) {
     std::fclose(f);
@@ -56,7 +58,8 @@ void DdsConfig::validate() const {
     throw FieldError("dds.profiles_file", profiles_file, "cannot read this file");
   }
   check_range("dds.domain_id", domain_id, 0, 232);
-  check_range("dds.participant_id", participant_id, -1, 119);
+  // RTPS ports: 7400 + 250 * domain + 11 + 2 * participant_id must stay below 65536.
+  check_range("dds.participant_id", participant_id, -1, max_participant_id(domain_id));
   if (!(lease_duration_s >= 1.0 && lease_duration_s <= 300.0))
     throw FieldError("dds.lease_duration_s", to_text(lease_duration_s), "must be in [1, 300]");
   if (discovery == Discovery::kInterface || discovery == Discovery::kPeers) {

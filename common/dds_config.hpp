@@ -22,6 +22,10 @@ enum class Discovery {
   kDiscoveryServer,  ///< opt-in: Fast DDS discovery server at ip:port
 };
 
+/// The largest RTPS participant id whose ports fit in domain_id (29062 at
+/// domain 0, 62 at domain 232). Fast DDS's automatic ids try only ~100.
+int max_participant_id(int domain_id);
+
 struct DdsConfig {
   int domain_id = 0;                  ///< DDS domain, [0, 232]
   Discovery discovery = Discovery::kLocalhost;
@@ -30,6 +34,7 @@ struct DdsConfig {
   std::string discovery_server;       ///< kDiscoveryServer: "ip:port" (port default 11811)
   bool shared_memory = true;          ///< add the SHM transport (same host only)
   int participant_id = -1;            ///< RTPS participant id, -1 = automatic; set explicitly past ~100 participants per host
+                                      ///< (at most max_participant_id(domain_id): the RTPS ports must fit)
   double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement
   std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles
   /// --secure: a directory made by scripts/make-certs; empty = DDS Security off

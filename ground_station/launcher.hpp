@@ -102,7 +102,7 @@ constexpr int kAutoDiscoveryServerAbove = 32;
 /// up, leaving ids below it for the server and tools (automatic).
 constexpr int kExplicitParticipantIdsAbove = 90;
 constexpr int kFirstAgentParticipantId = 4;
-constexpr int kMaxParticipantId = 119;  ///< dds.participant_id's upper bound (common/dds_config)
+constexpr int kMaxParticipantId = 1100;  ///< 1024 drones and then some; dds.participant_id also bounds it by domain (common/dds_config)
 
 /// The RTPS participant id the launcher gives drone_id's agent in a swarm of
 /// `drones`, or -1 for Fast DDS's automatic one.

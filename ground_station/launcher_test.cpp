@@ -1,5 +1,8 @@
 #include "ground_station/launcher.hpp"
 
+#include "common/config_error.hpp"
+#include "common/dds_config.hpp"
+
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -88,6 +91,20 @@ TEST(Launcher, LargeSwarmsAgentsGetExplicitParticipantIds) {
   EXPECT_EQ(agent_participant_id(kExplicitParticipantIdsAbove, 0), -1);  // automatic ids suffice
   EXPECT_EQ(agent_participant_id(110, 0), kFirstAgentParticipantId);
   EXPECT_EQ(agent_participant_id(110, 109), kFirstAgentParticipantId + 109);
-  EXPECT_LE(agent_participant_id(128, 115), kMaxParticipantId);
-  EXPECT_EQ(agent_participant_id(128, 127), -1);  // beyond dds.participant_id's range
+  EXPECT_EQ(agent_participant_id(128, 127), kFirstAgentParticipantId + 127);
+  EXPECT_EQ(agent_participant_id(1024, 1023), kFirstAgentParticipantId + 1023);
+  EXPECT_LE(agent_participant_id(1024, 1023), kMaxParticipantId);
+}
+
+TEST(Launcher, ParticipantIdsFitTheRtpsPortsOfTheirDomain) {
+  using namespace ddswarm;
+  EXPECT_EQ(max_participant_id(0), 29062);
+  EXPECT_EQ(max_participant_id(232), 62);
+  DdsConfig c;
+  c.profiles_file = DDSWARM_CONFIG_DIR "/dds_profiles.xml";
+  c.participant_id = 1027;  // the launcher's id for drone 1023
+  c.domain_id = 100;
+  EXPECT_NO_THROW(c.validate());
+  c.domain_id = 232;
+  EXPECT_THROW(c.validate(), FieldError);
 }
