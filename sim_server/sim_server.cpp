@@ -249,8 +249,11 @@ struct SimServer::Impl {
       std::erase_if(pending_beacons, [&](const msg::Beacon& b) { return b.drone_id() == c.drone_id(); });
       pending_beacons.push_back(c.own_beacon());
     }
+    const bool was_answered = s.answered;
     if (c.tick() == published_tick) s.answered = true;
-    cv.notify_all();
+    // One wake-up per tick: the main thread needs to run only when the last
+    // live agent has answered (it also wakes on its own every 20 ms).
+    if (s.answered && !was_answered && all_answered()) cv.notify_all();
   }
 
   void on_heartbeat(const msg::AgentStatus& a) {
