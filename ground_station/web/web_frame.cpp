@@ -1,6 +1,7 @@
 #include "ground_station/web/web_frame.hpp"
 
 #include <charconv>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -498,6 +499,31 @@ ParsedMessage parse_client_message(std::string_view text) {
     out.error = "message of " + std::to_string(text.size()) + " bytes: over the " +
                 std::to_string(kMaxClientMessageBytes / 1024) + " KiB limit";
     return out;
+  }
+  // Refuse deep nesting before parsing: nlohmann's dump and the checks below
+  // recurse, and a hostile page could send 30,000 '[' (stack overflow under
+  // ASan). No message of the protocol nests deeper than 3.
+  {
+    int depth = 0, deepest = 0;
+    bool in_string = false, escaped = false;
+    for (char c : text) {
+      if (in_string) {
+        if (escaped) escaped = false;
+        else if (c == '\\') escaped = true;
+        else if (c == '"') in_string = false;
+      } else if (c == '"') {
+        in_string = true;
+      } else if (c == '[' || c == '{') {
+        deepest = std::max(deepest, ++depth);
+      } else if (c == ']' || c == '}') {
+        --depth;
+      }
+    }
+    if (deepest > kMaxClientNesting) {
+      out.error = "message nested " + std::to_string(deepest) + " deep: over the limit of " +
+                  std::to_string(kMaxClientNesting);
+      return out;
+    }
   }
   json j;
   try {

@@ -23,6 +23,7 @@ namespace ddswarm::gs::web {
 constexpr int kProtocolVersion = 1;
 /// Client messages above this size are answered with `error` (bytes).
 constexpr std::size_t kMaxClientMessageBytes = 64 * 1024;
+constexpr int kMaxClientNesting = 8;  ///< arrays/objects inside each other; the protocol needs 3
 
 /// One drone as the page draws it.
 struct DroneFrame {
