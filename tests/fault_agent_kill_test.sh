@@ -18,7 +18,7 @@ gs task --no-wait || fail "task not accepted"
 kill -KILL "$PID_agent3"
 wait "$PID_agent3" 2>/dev/null
 started=$SECONDS
-gs task --attach >"$WORK/result.log" 2>&1; rc=$?
+timeout 240 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" task --attach >"$WORK/result.log" 2>&1; rc=$?
 cat "$WORK/result.log"
 echo "task finished $((SECONDS - started)) s (wall) after the kill"
 [ $rc -eq 0 ] || fail "the task did not complete without drone 3 (exit $rc)"
