@@ -26,13 +26,15 @@ grep -q "task complete:" "$WORK/result.log" || fail "no result line"
 grep -q "lost drones (agent lost, failsafe): 3" "$WORK/result.log" || fail "the lost drone is not reported"
 grep -q "drone 3: agent lost" "$WORK/sim.log" || fail "the server did not declare agent 3 lost"
 kill -INT "$PID_trace"; wait_pid "$PID_trace" 10 || fail "trace did not stop"
-# Drone 3 in the trace: failsafe flag (2) from some time t0; at t0 + 4 s it
-# still hovers (z > 1.5 m); at the end it is down (z < 0.3 m), motors off.
+# Drone 3 in the trace: failsafe flag (2) from some time t0; about 4 s later
+# it still hovers (z > 1.5 m; it lands after 5 s); at the end it is down (z < 0.3 m).
 awk -F, 'NR > 1 && $3 == 3 && int($11 / 2) % 2 == 1 { if (t0 == "") t0 = $2; z[$2] = $6; last = $2 }
          END {
            if (t0 == "") { print "drone 3 never in failsafe"; exit 1 }
-           best = ""; for (t in z) if (t >= t0 + 4 && t <= t0 + 4.5) best = t
-           if (best == "") { print "no sample 4 s into failsafe"; exit 1 }
+           # Array keys are strings: compare them as numbers. A slow (sanitizer)
+           # build thins the trace, so take the latest sample 3.5-4.9 s in.
+           best = ""; for (t in z) { tn = t + 0; if (tn >= t0 + 3.5 && tn <= t0 + 4.9 && (best == "" || tn > best + 0)) best = t }
+           if (best == "") { print "no sample 3.5-4.9 s into failsafe"; exit 1 }
            printf "failsafe from t=%.2f s: z=%.2f m at t=%.2f s, z=%.2f m at t=%.2f s\n", t0, z[best], best, z[last], last
            exit !(z[best] > 1.5 && z[last] < 0.3) }' "$WORK/trace.csv" || fail "drone 3 did not hover, then land"
 # Rejoin: the same id again. It takes off and resumes the task (past the finish line).
