@@ -108,6 +108,7 @@ struct SimServer::Impl {
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
+  int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
   double agent_d_int = 0;
   // Random per process: Scene and SimStatus carry it, so agents and ground
   // stations tell a restarted server (a new world) from the one they knew.
@@ -249,11 +250,12 @@ struct SimServer::Impl {
       std::erase_if(pending_beacons, [&](const msg::Beacon& b) { return b.drone_id() == c.drone_id(); });
       pending_beacons.push_back(c.own_beacon());
     }
-    const bool was_answered = s.answered;
-    if (c.tick() == published_tick) s.answered = true;
     // One wake-up per tick: the main thread needs to run only when the last
     // live agent has answered (it also wakes on its own every 20 ms).
-    if (s.answered && !was_answered && all_answered()) cv.notify_all();
+    if (c.tick() == published_tick && !s.answered) {
+      s.answered = true;
+      if (--unanswered == 0) cv.notify_all();
+    }
   }
 
   void on_heartbeat(const msg::AgentStatus& a) {
@@ -279,6 +281,7 @@ struct SimServer::Impl {
       s.live = true;
       s.owner = instance;
       s.answered = false;
+      ++unanswered;
     }
     s.last_heard_wall = wall_seconds();
   }
@@ -318,6 +321,7 @@ struct SimServer::Impl {
       if (s.live && now - s.last_heard_wall > cfg.sim.agent_timeout_s) {
         s.live = false;
         s.owner = 0;
+        if (!s.answered) --unanswered;
         counters.lockstep_timeouts(counters.lockstep_timeouts() + 1);
         spdlog::warn("drone {}: agent lost (silent for {:.1f} s); drone enters failsafe", i,
                      now - s.last_heard_wall);
@@ -498,7 +502,11 @@ struct SimServer::Impl {
       swarm_msg.beacons() = std::move(pending_beacons);
       pending_beacons.clear();
       published_tick = tick;
-      for (auto& s : slots) s.answered = false;
+      unanswered = 0;
+      for (auto& s : slots) {
+        s.answered = false;
+        unanswered += s.live;
+      }
     }
     swarm_msg.tick(tick);
     swarm_msg.sim_time_s(t);
@@ -669,11 +677,7 @@ struct SimServer::Impl {
   }
 
   /// Lockstep: true when every live agent has answered the published tick.
-  bool all_answered() {
-    for (const auto& s : slots)
-      if (s.live && !s.answered) return false;
-    return true;
-  }
+  bool all_answered() const { return unanswered == 0; }
   bool swarm_idle() {
     for (const auto& s : slots)
       if (s.live && s.busy) return false;
