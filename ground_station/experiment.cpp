@@ -153,7 +153,8 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
 
   // One run, on its own DDS domain (one per parallel job): fresh processes,
   // every one of them stopped before it returns.
-  auto run_one = [&](RunPlan& p, int domain) {
+  auto run_one = [&](std::size_t index, int domain) {
+    RunPlan& p = plans[index];
     RunRecord rec = p.rec;
     RunTimes times;
     const double run_start = wall_seconds();
@@ -227,13 +228,13 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
     sum.flight_s += times.flight_s;
     sum.teardown_s += times.teardown_s;
     out << "  " << p.tag << ": " << (rec.ok ? o.line() : "FAILED: " + rec.failure_reason) << std::endl;
-    records[&p - plans.data()] = rec;
+    records[index] = rec;
   };
 
   std::vector<std::thread> workers;
   for (int w = 0; w < jobs; ++w)
     workers.emplace_back([&, w] {
-      for (int i = next++; i < total && !stop_requested(); i = next++) run_one(plans[i], opt.dds.domain_id + w);
+      for (int i = next++; i < total && !stop_requested(); i = next++) run_one(i, opt.dds.domain_id + w);
     });
   for (auto& t : workers) t.join();
 
