@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "tests/fuzz/fuzz_check.hpp"
 #include "agent/mission_fsm.hpp"
 #include "common/convert.hpp"
 #include "common/topics.hpp"
@@ -23,14 +24,6 @@
 using namespace ddswarm;
 
 namespace {
-
-#define FUZZ_CHECK(cond)                                                   \
-  do {                                                                     \
-    if (!(cond)) {                                                         \
-      std::fprintf(stderr, "invariant failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__); \
-      __builtin_trap();                                                    \
-    }                                                                      \
-  } while (0)
 
 template <class T>
 bool deserialise(std::vector<std::uint8_t>& bytes, T& out) {

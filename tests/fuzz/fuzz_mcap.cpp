@@ -16,20 +16,13 @@
 #include <tuple>
 #include <vector>
 
+#include "tests/fuzz/fuzz_check.hpp"
 #include "common/mcap/mcap_reader.hpp"
 #include "common/mcap/mcap_writer.hpp"
 
 using namespace ddswarm::mcap;
 
 namespace {
-
-#define FUZZ_CHECK(cond)                                                                  \
-  do {                                                                                    \
-    if (!(cond)) {                                                                        \
-      std::fprintf(stderr, "invariant failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__); \
-      __builtin_trap();                                                                   \
-    }                                                                                     \
-  } while (0)
 
 std::string scratch(const char* what) {
   const char* dir = std::getenv("TMPDIR");
