@@ -8,7 +8,7 @@
 import * as THREE from 'three';
 import { mergeGeometries } from 'three/addons/utils/BufferGeometryUtils.js';
 import { FLAG } from './protocol.js';
-import { surface } from './world.js';
+import { LIT_FRAGMENT_SHADER, surface } from './world.js';
 
 // Rotor layout (sim_server/quadrotor.hpp): 0 front-right CCW, 1 rear-left CCW,
 // 2 front-left CW, 3 rear-right CW; arms at -45, 135, 45, -135 degrees.
@@ -125,16 +125,7 @@ function quadMaterial(centres) {
         gl_Position = projectionMatrix * mvPosition;
         #include <fog_vertex>
       }`,
-    fragmentShader: `
-      #include <common>
-      #include <fog_pars_fragment>
-      varying vec3 vLit;
-      void main() {
-        gl_FragColor = vec4(vLit, 1.0);
-        #include <tonemapping_fragment>
-        #include <colorspace_fragment>
-        #include <fog_fragment>
-      }`,
+    fragmentShader: LIT_FRAGMENT_SHADER,
   });
 }
 

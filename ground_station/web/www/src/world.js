@@ -6,6 +6,19 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
+// The fragment half of the vertex-lit materials (pillars here, drones in
+// drones.js): the vertex shader computes vLit, this only writes it out.
+export const LIT_FRAGMENT_SHADER = `
+  #include <common>
+  #include <fog_pars_fragment>
+  varying vec3 vLit;
+  void main() {
+    gl_FragColor = vec4(vLit, 1.0);
+    #include <tonemapping_fragment>
+    #include <colorspace_fragment>
+    #include <fog_fragment>
+  }`;
+
 const Z_UP = new THREE.Vector3(0, 0, 1);
 
 // Lit surfaces. Lambert, not the physically based standard material: on
@@ -350,16 +363,7 @@ function vertexLit(colour, world) {
         gl_Position = projectionMatrix * mvPosition;
         #include <fog_vertex>
       }`,
-    fragmentShader: `
-      #include <common>
-      #include <fog_pars_fragment>
-      varying vec3 vLit;
-      void main() {
-        gl_FragColor = vec4(vLit, 1.0);
-        #include <tonemapping_fragment>
-        #include <colorspace_fragment>
-        #include <fog_fragment>
-      }`,
+    fragmentShader: LIT_FRAGMENT_SHADER,
   });
 }
 
