@@ -26,11 +26,12 @@ for i in 0 1 2 3 4 5; do start "b$i" "$BIN/ddswarm-agent" --id $i --config "$sce
 for _ in $(seq 50); do grep -q "left by crashed processes" "$WORK/sim2.log" && break; sleep 0.1; done
 # (Another ddswarm-sim starting meanwhile on this machine may have cleaned them first.)
 grep "left by crashed processes" "$WORK/sim2.log" || echo "note: the new server found nothing to clean"
+gs wait-agents --count 6 --timeout 60 || fail "the next swarm's agents are not online"
+gs takeoff --wait || fail "the next swarm did not take off"
 # Port files are named by domain and participant: the new swarm opens the
-# same names again. What must not remain is a file nobody maps.
+# same names again (checked once it flies, so none is caught half-opened).
+# What must not remain is a file nobody maps.
 live_maps=$(cat /proc/[0-9]*/maps 2>/dev/null | grep -o '/dev/shm/fast[^ ]*' | sort -u)
 still=$(for f in $ours; do [ -e "$f" ] && ! grep -qxF "$f" <<<"$live_maps" && echo "$f"; done)
 [ -z "$still" ] || fail "zombie files of the killed swarm remain: $still"
-gs wait-agents --count 6 --timeout 60 || fail "the next swarm's agents are not online"
-gs takeoff --wait || fail "the next swarm did not take off"
 echo PASS
