@@ -53,8 +53,11 @@ msg::SwarmState make_state(int n) {
   return s;
 }
 
+std::string g_profiles;  // --profiles: a QoS profiles file other than ddswarm's
+
 DdsConfig dds_for(int domain, const std::string& server, int participant_id = -1) {
   DdsConfig c;
+  if (!g_profiles.empty()) c.profiles_file = g_profiles;
   c.domain_id = domain;
   c.participant_id = participant_id;
   if (!server.empty()) {
@@ -128,6 +131,7 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
   for (int i = 0; i < n; ++i) {
     std::vector<std::string> a = {self_exe(), "--respond", std::to_string(i), "--domain", std::to_string(domain),
                                   "--duration", fmt::format("{:.0f}", child_budget)};
+    if (!g_profiles.empty()) a.insert(a.end(), {"--profiles", g_profiles});
     if (use_server) {
       a.push_back("--discovery-server");
       a.push_back(server);
@@ -256,12 +260,14 @@ int main(int argc, char** argv) {
     app.add_option("--time", measure_s, "s of lockstep measured");
     app.add_option("--idle", idle_s, "s of idle CPU measured after discovery");
     app.add_option("--discovery-timeout", discovery_timeout_s, "s to wait for discovery");
-    app.add_option("--domain", domain, "DDS domain (default: random in 100-199)");
+    app.add_option("--domain", domain, "DDS domain (default: random in 20-79, whose RTPS ports stay below the ephemeral port range)");
+    app.add_option("--profiles", g_profiles, "QoS profiles XML (default: ddswarm's config/dds_profiles.xml)")
+        ->check(CLI::ExistingFile);
     app.add_option("--csv", csv, "append one row per run to this CSV");
     app.add_option("--log-dir", log_dir, "responder and discovery-server logs (default: discarded)");
     app.add_flag("--explicit-ids", explicit_ids,
                  "give every participant its RTPS participant id (publisher 0, responder i: i+1) instead of "
-                 "Fast DDS's automatic one; needs N <= 119 (dds.participant_id's range)");
+                 "Fast DDS's automatic one (needs N < dds.participant_id's limit for the domain)");
     app.add_option("--participant-id", participant_id, "internal: responder's participant id")->group("");
     app.add_option("--respond", respond_id, "internal: run as responder ID")->group("");
     app.add_option("--discovery-server", server, "internal: responder's discovery server")->group("");
@@ -271,7 +277,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
       return app.exit(e) == 0 ? 0 : 2;
     }
-    if (domain < 0) domain = 100 + static_cast<int>(random_instance() % 100);
+    if (domain < 0) domain = 20 + static_cast<int>(random_instance() % 60);
     if (respond_id >= 0) return respond(respond_id, domain, server, duration_s, participant_id);
     install_stop_signals();
     if (!log_dir.empty()) std::filesystem::create_directories(log_dir);
@@ -291,11 +297,12 @@ int main(int argc, char** argv) {
           continue;
         }
         std::fprintf(stderr, "dds_floor: N=%d, %s discovery ...\n", n, use_server ? "server" : "simple");
-        if (explicit_ids && n > 119) {
+        if (explicit_ids && n > max_participant_id(domain) - 1) {
           Result r;
           r.n = n;
           r.discovery = use_server ? "server" : "simple";
-          r.why = "skipped: explicit ids need N <= 119 (dds.participant_id range)";
+          r.why = fmt::format("skipped: explicit ids need N <= {} in domain {} (dds.participant_id range)",
+                              max_participant_id(domain) - 1, domain);
           results.push_back(r);
           continue;
         }

@@ -102,7 +102,7 @@ EOF
 # run_swarm MODE N SECONDS: launches N agents, takes off, holds, probes; prints the probe line.
 run_swarm() {
   local mode="$1" n="$2" secs="$3"
-  local dom=$(( (RANDOM % 100) + 120 )) log="$OUT/$mode-$n"
+  local dom=$(( (RANDOM % 60) + 20 )) log="$OUT/$mode-$n"
   rm -rf "$log"; mkdir -p "$log"
   local bound=$(( secs + 400 ))
   local t0; t0=$(date +%s.%N)
@@ -253,7 +253,7 @@ if ! skip table1; then
   rm -rf "$T1"; mkdir -p "$T1"
   sed -e "s#^\( *scenario:\) *thesis_course.yaml#\1 $SRC/config/thesis_course.yaml#" \
       -e "s#^\( *runs_per_set:\) *[0-9]*#\1 $T1_RUNS#" "$SRC/config/table1.yaml" >"$T1/table1.yaml"
-  dom=$(( (RANDOM % 100) + 120 ))
+  dom=$(( (RANDOM % 60) + 20 ))
   echo "swarm_bench: Table 1, 4 sets x $T1_RUNS runs (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
   t0=$(date +%s.%N)
   timeout $(( 60 * T1_RUNS + 300 )) "$BIN/ddswarm-gs" --domain "$dom" experiment "$T1/table1.yaml" --out "$T1/out" \

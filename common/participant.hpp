@@ -65,10 +65,12 @@ class Reader : public fdds::DataReaderListener {
   int matched() const { return matched_.load(); }
 
   void on_data_available(fdds::DataReader* reader) override {
-    T sample;
+    // One sample object, reused: deserializing into it keeps its sequences'
+    // capacity, so a whole-swarm sample costs no allocation per drone per tick.
+    std::lock_guard<std::mutex> lock(sample_mu_);
     fdds::SampleInfo info;
-    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data && handler_) handler_(sample, info);
+    while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK) {
+      if (info.valid_data && handler_) handler_(sample_, info);
     }
   }
   void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {
@@ -79,6 +81,8 @@ class Reader : public fdds::DataReaderListener {
   SampleHandler<T> handler_;
   fdds::DataReader* r_ = nullptr;
   std::atomic<int> matched_{0};
+  std::mutex sample_mu_;  // transports' receive threads may deliver at once
+  T sample_;
 };
 
 class Participant {

@@ -221,6 +221,14 @@ int main(int argc, char** argv) {
                                "ids, and past ~100 participants per host Fast DDS leaves them unreachable "
                                "(dds.participant_id stops at {}; docs/performance.md)\n",
                                n, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
+    if (agent_hosts == 0 && !ids.empty() && agent_participant_id(n, ids.front()) >= 0) {
+      int lo = 0, hi = -1;
+      std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> lo >> hi;
+      const int domain = app.count("--domain") ? app.get_option("--domain")->as<int>() : file.dds.domain_id;
+      const std::string w = ephemeral_port_warning(domain, agent_participant_id(n, ids.front()),
+                                                   agent_participant_id(n, ids.back()), lo, hi);
+      if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
+    }
     // Agent hosts: K processes, each flying a contiguous share of the ids.
     for (int h = 0; agent_hosts > 0 && h < agent_hosts && h < static_cast<int>(ids.size()); ++h) {
       const std::size_t per = (ids.size() + agent_hosts - 1) / agent_hosts;

@@ -1,6 +1,7 @@
 #include "ground_station/launcher.hpp"
 
 #include <arpa/inet.h>
+#include <fmt/format.h>
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -262,6 +263,17 @@ int agent_participant_id(int drones, int drone_id) {
   if (drones <= kExplicitParticipantIdsAbove) return -1;
   const int pid = kFirstAgentParticipantId + drone_id;
   return pid <= kMaxParticipantId ? pid : -1;
+}
+
+std::string ephemeral_port_warning(int domain, int first_id, int last_id, int lo, int hi) {
+  const auto port = [](int d, int id) { return 7400 + 250 * d + 10 + 2 * id; };
+  const int low = port(domain, first_id), high = port(domain, last_id) + 1;
+  if (first_id < 0 || last_id < first_id || high < lo || low > hi) return "";
+  const int clear_domain = (lo - 1 - port(0, last_id) - 1) / 250;  // largest d with every port below lo
+  return fmt::format("participant ids {}-{} in domain {} use RTPS ports {}-{}, inside this machine's ephemeral "
+                     "port range {}-{}: a participant whose port another socket holds is never discovered; "
+                     "use --domain {} or lower",
+                     first_id, last_id, domain, low, high, lo, hi, std::max(0, clear_domain));
 }
 
 ChildSpec discovery_server_spec(int port) {

@@ -108,6 +108,15 @@ constexpr int kMaxParticipantId = 1100;  ///< 1024 drones and then some; dds.par
 /// `drones`, or -1 for Fast DDS's automatic one.
 int agent_participant_id(int drones, int drone_id);
 
+/// The RTPS unicast ports (metatraffic and user, 7400 + 250*domain + 10/11 +
+/// 2*id) of explicit participant ids [first_id, last_id] that fall inside the
+/// kernel's ephemeral port range [lo, hi] (/proc/sys/net/ipv4/ip_local_port_range).
+/// Any process's outgoing socket may hold such a port, and the participant that
+/// needs it then never binds it and is never discovered (2 of 128 agents in
+/// domain 120+, docs/performance.md). Returns a one-line warning naming the
+/// largest domain that keeps clear of the range, or "" when clear.
+std::string ephemeral_port_warning(int domain, int first_id, int last_id, int lo, int hi);
+
 /// True when the launcher should start its own server. `starts_whole_swarm`:
 /// it starts the server and every agent (a local server cannot serve a swarm
 /// split across hosts); `localhost_discovery`: no other network was opted into.

@@ -96,6 +96,17 @@ TEST(Launcher, LargeSwarmsAgentsGetExplicitParticipantIds) {
   EXPECT_LE(agent_participant_id(1024, 1023), kMaxParticipantId);
 }
 
+TEST(Launcher, WarnsWhenExplicitIdsUseEphemeralPorts) {
+  // 128 agents (ids 4-131) in domain 150: ports 44918-45173, inside Linux's 32768-60999.
+  const std::string w = ephemeral_port_warning(150, 4, 131, 32768, 60999);
+  EXPECT_NE(w.find("ports 44918-45173"), std::string::npos) << w;
+  EXPECT_NE(w.find("use --domain 100 or lower"), std::string::npos) << w;
+  // The advice holds: domain 100 keeps every port below the range; 101 does not.
+  EXPECT_EQ(ephemeral_port_warning(100, 4, 131, 32768, 60999), "");
+  EXPECT_NE(ephemeral_port_warning(101, 4, 131, 32768, 60999), "");
+  EXPECT_EQ(ephemeral_port_warning(0, 4, 1027, 32768, 60999), "");
+}
+
 TEST(Launcher, ParticipantIdsFitTheRtpsPortsOfTheirDomain) {
   using namespace ddswarm;
   EXPECT_EQ(max_participant_id(0), 29062);

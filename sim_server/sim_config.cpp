@@ -13,6 +13,7 @@ void load(YamlSection s, SimConfig& c) {
   s.get("agent_timeout_s", c.agent_timeout_s);
   s.get("max_command_speed_mps", c.max_command_speed_mps);
   s.get("pause_when_idle", c.pause_when_idle);
+  s.get("realtime_grace", c.realtime_grace);
   s.get("status_rate_hz", c.status_rate_hz);
   s.get("publish_per_drone_topics", c.publish_per_drone_topics);
   s.get("task_timeout_s", c.task_timeout_s);
@@ -41,6 +42,7 @@ void SimConfig::validate() const {
   check_non_negative("sim.failsafe_land_after_s", failsafe_land_after_s);
   check_range("sim.agent_timeout_s", agent_timeout_s, 0.1, 60.0);
   check_positive("sim.max_command_speed_mps", max_command_speed_mps);
+  check_range("sim.realtime_grace", realtime_grace, 0.0, 0.9);
   check_range("sim.status_rate_hz", status_rate_hz, 0.1, 100.0);
   check_positive("sim.task_timeout_s", task_timeout_s);
   check_positive("sim.airborne_height_m", airborne_height_m);

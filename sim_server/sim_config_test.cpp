@@ -34,6 +34,7 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
             "3: sim.control_rate_hz = 30: must divide physics_rate_hz (1000)");
   EXPECT_EQ(error_for("scene:\n  cylinders:\n    - {center_xy: [5, 5], radius_m: -2}\n"),
             "3: scene.cylinders[0].radius_m = -2: must be > 0");
+  EXPECT_EQ(error_for("sim:\n  realtime_grace: 1.5\n"), "2: sim.realtime_grace = 1.5: must be in [0, 0.9]");
   EXPECT_EQ(error_for("sim:\n  colour: red\n"), "2: sim.colour: unknown key");
   EXPECT_EQ(error_for("wings: 2\n"), "1: wings: unknown section");
   EXPECT_EQ(error_for("sensors:\n  count: many\n"), "2: sensors.count = many: must be an integer");

@@ -250,6 +250,9 @@ struct SimServer::Impl {
       std::erase_if(pending_beacons, [&](const msg::Beacon& b) { return b.drone_id() == c.drone_id(); });
       pending_beacons.push_back(c.own_beacon());
     }
+    // Real time: an answer to a state older than the newest arrived after the
+    // step it was meant for (it is still the freshest, so it is applied).
+    if (c.tick() < published_tick) counters.commands_late(counters.commands_late() + 1);
     // One wake-up per tick: the main thread needs to run only when the last
     // live agent has answered (it also wakes on its own every 20 ms).
     if (c.tick() == published_tick && !s.answered) {
@@ -556,10 +559,13 @@ struct SimServer::Impl {
     for (auto& b : swarm_msg.beacons()) b.true_position(swarm_msg.drones()[b.drone_id()].position());
     bool task_changed = referee.update(t, positions, cfg.sim.task_timeout_s);
     w_swarm.write(swarm_msg);
+    // Best-effort, volatile topics: with no reader matched (no recorder or
+    // tool listening) the 2N writes would only serialize into the history.
     if (cfg.sim.publish_per_drone_topics) {
-      for (int i = 0; i < n; ++i) {
-        w_drone.write(swarm_msg.drones()[i]);
-        if (scan_tick) w_scan.write(swarm_msg.scans()[i]);
+      const bool drones = w_drone.matched() > 0, scans = scan_tick && w_scan.matched() > 0;
+      for (int i = 0; i < n && (drones || scans); ++i) {
+        if (drones) w_drone.write(swarm_msg.drones()[i]);
+        if (scans) w_scan.write(swarm_msg.scans()[i]);
       }
     }
     publish_task(task_changed);
@@ -659,6 +665,8 @@ struct SimServer::Impl {
     publish_tick();
     auto next = Clock::now();
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
+    const auto grace = std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(period_s * cfg.sim.realtime_grace));
     while (!stop_requested() && wall_seconds() < deadline_wall) {
       next += period;
       auto now = Clock::now();
@@ -669,8 +677,12 @@ struct SimServer::Impl {
       }
       std::this_thread::sleep_until(next);
       {
-        std::lock_guard<std::mutex> lock(mu);
+        std::unique_lock<std::mutex> lock(mu);
         expire_agents();
+        // A live agent a little late (descheduled for a moment) still gets
+        // its answer into this step; the deadline of the next period stays.
+        if (unanswered > 0 && grace.count() > 0)
+          cv.wait_until(lock, next + grace, [&] { return unanswered == 0 || stop_requested(); });
       }
       advance();
     }
