@@ -15,6 +15,8 @@
 #   --skip floor,lockstep,realtime,table1   parts to leave out
 #   --table1-runs K    runs per set for Table 1 (default 15, the thesis's)
 #   --plot FILE.png    real-time factor against N (gnuplot)
+#   --set KEY=VALUE    scenario override for every swarm (ddswarm-launch --set), repeatable,
+#                      e.g. --set sim.physics_rate_hz=500
 #   --quick            a smoke run: N = 4 and 8, a few seconds each, 1 run per Table 1 set
 # Every process is started here or by ddswarm-launch and stopped by PID; every
 # run is bounded in time.
@@ -30,6 +32,7 @@ FLOOR_TIME=5
 SKIP=""
 T1_RUNS=15
 PLOT=""
+SETS=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) BIN="$2"; shift 2 ;;
@@ -42,8 +45,9 @@ while [ $# -gt 0 ]; do
     --skip) SKIP="$2"; shift 2 ;;
     --table1-runs) T1_RUNS="$2"; shift 2 ;;
     --plot) PLOT="$2"; shift 2 ;;
+    --set) SETS+=(--set "$2"); shift 2 ;;
     --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; shift ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     *) echo "swarm_bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -107,7 +111,7 @@ run_swarm() {
   local bound=$(( secs + 400 ))
   local t0; t0=$(date +%s.%N)
   "$BIN/ddswarm-launch" "$SCENARIO" --drones "$n" --mode "$mode" --domain "$dom" --log-dir "$log" \
-    --discovery-server auto --duration "$bound" >"$log/launch.out" 2>"$log/launch.err" &
+    --discovery-server auto --duration "$bound" "${SETS[@]}" >"$log/launch.out" 2>"$log/launch.err" &
   LAUNCH_PID=$!
   local ds=()
   for _ in $(seq 50); do

@@ -99,9 +99,13 @@ constexpr int kAutoDiscoveryServerAbove = 32;
 /// pair among 100 (ids 0-99), so past ~100 participants per host and domain the
 /// rest are unreachable, discovery server or not (bench/dds_floor). Large
 /// swarms' agents therefore get explicit ids, from kFirstAgentParticipantId
-/// up, leaving ids below it for the server and tools (automatic).
+/// up, leaving ids below it for the server and tools (automatic). Automatic
+/// ids search upwards from 0 for a free port pair, so every tool that joins
+/// (ground stations, recorder, probes, web bridge) needs a free id below the
+/// agents: with 4 free, the fifth tool of a 128-process swarm never found the
+/// server. 32 leaves room for them all.
 constexpr int kExplicitParticipantIdsAbove = 90;
-constexpr int kFirstAgentParticipantId = 4;
+constexpr int kFirstAgentParticipantId = 32;
 constexpr int kMaxParticipantId = 1100;  ///< 1024 drones and then some; dds.participant_id also bounds it by domain (common/dds_config)
 
 /// The RTPS participant id the launcher gives drone_id's agent in a swarm of
