@@ -11,9 +11,10 @@ declare -a PIDS=()
 declare -a NAMES=()
 
 print_logs() {
-  for f in "$WORK"/*.log; do
+  # The test's own logs, and those a launcher wrote into a subdirectory (--log-dir).
+  for f in "$WORK"/*.log "$WORK"/*/*.log; do
     [ -f "$f" ] || continue
-    echo "----- $(basename "$f") (last 60 lines) -----"
+    echo "----- ${f#"$WORK"/} (last 60 lines) -----"
     tail -n 60 "$f"
   done
 }
