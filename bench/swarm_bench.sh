@@ -12,8 +12,12 @@
 #   --time S           lockstep seconds measured per N (default 10)
 #   --rt-time S        real-time seconds measured per N (default 60)
 #   --floor-time S     floor seconds measured per N (default 5)
-#   --skip floor,lockstep,realtime,table1   parts to leave out
+#   --skip floor,lockstep,realtime,hosts,table1   parts to leave out
+#   --hosts-drones N   agent-host part: N drones of config/swarm_field.yaml in real time,
+#                      flown by --agent-hosts K processes (default 512 and 2), physics and
+#                      sensor rates --hosts-physics / --hosts-sensors Hz (default 250 / 10)
 #   --table1-runs K    runs per set for Table 1 (default 15, the thesis's)
+#   --table1-jobs J    Table 1 runs at a time, each on its own domain (default 2)
 #   --plot FILE.png    real-time factor against N (gnuplot)
 #   --set KEY=VALUE    scenario override for every swarm (ddswarm-launch --set), repeatable,
 #                      e.g. --set sim.physics_rate_hz=500
@@ -33,6 +37,11 @@ SKIP=""
 T1_RUNS=15
 PLOT=""
 SETS=()
+HOSTS_N=512
+HOSTS_K=2
+HOSTS_PHYS=250
+HOSTS_SENS=10
+T1_JOBS=2
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) BIN="$2"; shift 2 ;;
@@ -46,8 +55,13 @@ while [ $# -gt 0 ]; do
     --table1-runs) T1_RUNS="$2"; shift 2 ;;
     --plot) PLOT="$2"; shift 2 ;;
     --set) SETS+=(--set "$2"); shift 2 ;;
-    --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    --hosts-drones) HOSTS_N="$2"; shift 2 ;;
+    --agent-hosts) HOSTS_K="$2"; shift 2 ;;
+    --hosts-physics) HOSTS_PHYS="$2"; shift 2 ;;
+    --hosts-sensors) HOSTS_SENS="$2"; shift 2 ;;
+    --table1-jobs) T1_JOBS="$2"; shift 2 ;;
+    --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; HOSTS_N=16; shift ;;
+    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
     *) echo "swarm_bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -104,14 +118,18 @@ EOF
 
 # ---------------------------------------------------------------- one swarm
 # run_swarm MODE N SECONDS: launches N agents, takes off, holds, probes; prints the probe line.
+RUN_SCENARIO=""   # run_swarm's scenario (default: $SCENARIO)
+RUN_EXTRA=()      # run_swarm's extra ddswarm-launch arguments
+RUN_TAG=""        # run_swarm's log directory suffix
 run_swarm() {
   local mode="$1" n="$2" secs="$3"
-  local dom=$(( (RANDOM % 60) + 20 )) log="$OUT/$mode-$n"
+  local scenario="${RUN_SCENARIO:-$SCENARIO}"
+  local dom=$(( (RANDOM % 60) + 20 )) log="$OUT/$mode-$n$RUN_TAG"
   rm -rf "$log"; mkdir -p "$log"
   local bound=$(( secs + 400 ))
   local t0; t0=$(date +%s.%N)
-  "$BIN/ddswarm-launch" "$SCENARIO" --drones "$n" --mode "$mode" --domain "$dom" --log-dir "$log" \
-    --discovery-server auto --duration "$bound" "${SETS[@]}" >"$log/launch.out" 2>"$log/launch.err" &
+  "$BIN/ddswarm-launch" "$scenario" --drones "$n" --mode "$mode" --domain "$dom" --log-dir "$log" \
+    --discovery-server auto --duration "$bound" "${SETS[@]}" "${RUN_EXTRA[@]}" >"$log/launch.out" 2>"$log/launch.err" &
   LAUNCH_PID=$!
   local ds=()
   for _ in $(seq 50); do
@@ -119,7 +137,7 @@ run_swarm() {
   done
   local addr; addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$log/launch.err")
   [ -n "$addr" ] && ds=(--discovery-server "$addr")
-  local gs=("$BIN/ddswarm-gs" --config "$SCENARIO" --domain "$dom" "${ds[@]}")
+  local gs=("$BIN/ddswarm-gs" --config "$scenario" --domain "$dom" "${ds[@]}")
   local up="nan" why=""
   if timeout 200 "${gs[@]}" wait-agents --count "$n" --timeout 180 >"$log/gs-wait.log" 2>&1; then
     up=$(echo "$(date +%s.%N) - $t0" | bc)
@@ -210,6 +228,30 @@ if ! skip realtime; then
   echo "largest N meeting the real-time criteria: $best"
 fi
 
+# ---------------------------------------------------------------- agent hosts
+if ! skip hosts; then
+  RUN_SCENARIO="$OUT/hosts_scenario.yaml"
+  sed -e 's/^  ack_timeout_s: .*/  ack_timeout_s: 30.0\n  discovery_timeout_s: 60.0/' "$SRC/config/swarm_field.yaml" >"$RUN_SCENARIO"
+  grep -q "discovery_timeout_s: 60.0" "$RUN_SCENARIO" || { echo "swarm_bench: cannot derive $RUN_SCENARIO" >&2; exit 2; }
+  RUN_EXTRA=(--agent-hosts "$HOSTS_K" --set "sim.physics_rate_hz=$HOSTS_PHYS" --set "sim.sensor_rate_hz=$HOSTS_SENS")
+  RUN_TAG="-hosts"
+  echo "swarm_bench: agent hosts, $HOSTS_N drones in $HOSTS_K processes, real time ${RT_TIME} s (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
+  l="$(run_swarm realtime "$HOSTS_N" "$RT_TIME") load=$(cut -d' ' -f1 /proc/loadavg)"
+  RUN_SCENARIO=""; RUN_EXTRA=(); RUN_TAG=""
+  echo "$l" >"$OUT/hosts.txt"
+  rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l"); mf=$(field missed_frac "$l")
+  echo
+  echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, ${RT_TIME} s =="
+  echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | host RSS (MB) | bring-up + discovery (s) | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
+  printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
+    "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
+    "$(echo "${mf:-}" | awk '{ if ($1 != "") printf "%.3f %%", 100 * $1; else print "-" }')" \
+    "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" "$(field cpu_agent_each "$l")" "$(field rss_agent_mb "$l")" \
+    "$(field up_s "$l" | awk '{ printf "%.1f", $1 }')" "$(field load "$l")" \
+    "$(echo "$l" | sed -n 's/.*why="\([^"]*\)".*/\1/p')"
+fi
+
 # ---------------------------------------------------------------- plot
 if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   : >"$OUT/plot.dat"
@@ -261,10 +303,11 @@ if ! skip table1; then
   echo "swarm_bench: Table 1, 4 sets x $T1_RUNS runs (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
   t0=$(date +%s.%N)
   timeout $(( 60 * T1_RUNS + 300 )) "$BIN/ddswarm-gs" --domain "$dom" experiment "$T1/table1.yaml" --out "$T1/out" \
+    --jobs "$T1_JOBS" \
     >"$T1/experiment.log" 2>&1
   rc=$?
   total=$(echo "$(date +%s.%N) - $t0" | bc)
   echo
-  echo "== Table 1: 4 sets x $T1_RUNS lockstep runs of the six-drone task (exit $rc, load $(cut -d' ' -f1 /proc/loadavg)) =="
+  echo "== Table 1: 4 sets x $T1_RUNS lockstep runs of the six-drone task, $T1_JOBS at a time (exit $rc, load $(cut -d' ' -f1 /proc/loadavg)) =="
   $PY "$SRC/bench/table1_split.py" "$T1/out" "$total"
 fi

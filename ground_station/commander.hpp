@@ -38,6 +38,10 @@ struct SwarmStatus {
   /// agent's AgentStatus.rejected_samples). Empty when nothing was heard.
   std::vector<std::pair<std::string, std::uint64_t>> rejected;
   int failsafe = 0;             ///< drones in failsafe (agent lost: hovering or landing)
+  /// Velocity commands the server applied since start, and (real time) those
+  /// that arrived after the step they answered; -1 = no server heard.
+  std::int64_t commands_applied = -1;
+  std::int64_t commands_late = -1;
   std::string task;             ///< the refereed task, e.g. "running 12.0 s, 2/6 past finish"; "" = none
 };
 

@@ -230,6 +230,7 @@ int main(int argc, char** argv) {
       gs.wait_task_status(file.gs.discovery_timeout_s);  // latched: follows the match when there is one
       const SwarmStatus st = gs.status();
       std::printf("%s\n%s\n", format_status(st).c_str(), format_rejections(st).c_str());
+      if (const std::string c = format_commands(st); !c.empty()) std::printf("%s\n", c.c_str());
       if (status_drones) {
         auto snap = snapshot(file.dds, 3.0);
         if (!snap) {

@@ -453,6 +453,12 @@ std::string format_rejections(const SwarmStatus& s) {
   return "rejected samples: " + std::to_string(total) + " (" + parts + ")";
 }
 
+std::string format_commands(const SwarmStatus& s) {
+  if (s.commands_applied < 0) return "";
+  return "commands: " + std::to_string(s.commands_applied) + " applied, " + std::to_string(s.commands_late) +
+         " late (answered after their step)";
+}
+
 int run_menu(Commander& commander, LineReader& reader, std::ostream& out,
              const MenuOptions& options) {
   options.validate();

@@ -58,4 +58,8 @@ std::string format_status(const SwarmStatus& s);
 /// nothing was heard yet.
 std::string format_rejections(const SwarmStatus& s);
 
+/// "commands: 1200 applied, 3 late (answered after their step)"; "" when no
+/// server was heard.
+std::string format_commands(const SwarmStatus& s);
+
 }  // namespace ddswarm::gs

@@ -338,5 +338,13 @@ TEST(Status, RejectionsAreCountedByReason) {
   EXPECT_EQ(format_rejections(s), "rejected samples: 6 (non-finite 3, absurd 0, mission 2, agents 1)");
 }
 
+TEST(Status, CommandsAppliedAndLate) {
+  SwarmStatus s;
+  EXPECT_EQ(format_commands(s), "");  // no server heard
+  s.commands_applied = 1200;
+  s.commands_late = 3;
+  EXPECT_EQ(format_commands(s), "commands: 1200 applied, 3 late (answered after their step)");
+}
+
 }  // namespace
 }  // namespace ddswarm::gs

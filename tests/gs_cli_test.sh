@@ -39,6 +39,11 @@ kill -CONT "$frozen"
 echo "$out"
 [ $rc -eq 1 ] || fail "hold with a frozen agent exited $rc"
 echo "$out" | grep -q "no ack from drones 2" || fail "missing ack not named: $out"
+# Status reports the server's command counts (applied; late = answered after their step).
+out=$(gs status) || fail "status after the thaw: $out"
+echo "$out"
+applied=$(echo "$out" | sed -n 's/^commands: \([0-9]*\) applied, [0-9]* late.*/\1/p')
+[ -n "$applied" ] && [ "$applied" -gt 0 ] || fail "no command count in status: $out"
 out=$(gs land --wait); rc=$?
 [ $rc -eq 0 ] || fail "land exited $rc: $out"
 echo PASS
