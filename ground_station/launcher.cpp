@@ -143,9 +143,13 @@ void Launcher::pump() {
     if (fds[0].revents) (void)!read(wake_[0], buf, sizeof buf);
     for (std::size_t i = 1; i < fds.size(); ++i) {
       if (!fds[i].revents) continue;
-      ssize_t n = read(fds[i].fd, buf, sizeof buf);
+      // Under the lock, and only while the fd is still this child's: reap()
+      // may have drained and closed it since poll(), and a new child's pipe
+      // may have the same number by now (a race TSan found).
       std::lock_guard<std::mutex> lock(mu_);
       Child* c = owners[i];
+      if (c->out_fd != fds[i].fd) continue;
+      ssize_t n = read(c->out_fd, buf, sizeof buf);
       if (n > 0) {
         emit(*c, buf, static_cast<std::size_t>(n), false);
       } else {

@@ -6,7 +6,7 @@
 source "$(dirname "$0")/lib.sh"
 out="$WORK/results"
 out2="$WORK/results2"
-timeout 400 "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out" \
+timeout "$(slow 400)" "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out" \
   >"$WORK/experiment.log" 2>&1
 rc=$?
 cat "$WORK/experiment.log"
@@ -23,7 +23,7 @@ svgs=$(ls "$out"/plots/*.svg 2>/dev/null | wc -l)
 [ -s "$out/plots/summary.png" ] || fail "no summary plot"
 ls "$out"/runs/*.yaml | wc -l | grep -qx 4 || fail "expected 4 per-run scenarios"
 grep -Eq "wall time per run .*start-up .*flight .*teardown" "$WORK/experiment.log" || fail "no wall-time split"
-timeout 400 "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out2" \
+timeout "$(slow 400)" "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out2" \
   --jobs 2 >"$WORK/experiment2.log" 2>&1 || { cat "$WORK/experiment2.log"; fail "experiment --jobs 2 failed"; }
 tail -3 "$WORK/experiment2.log"
 results() { awk -F, 'NR > 1 { print $1, $2, $3, $9, $11, $13, $14, $15, $16 }' "$1" | sort; }

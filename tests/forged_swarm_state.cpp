@@ -45,7 +45,11 @@ int main(int argc, char** argv) {
       if (watching && !s.drones().empty())
         max_dz = std::max(max_dz, std::abs(s.drones()[0].position().z() - z));
     });
-    for (int i = 0; i < 50 && !have_status; ++i) wait_for_stop(std::chrono::milliseconds(100));
+    const auto heard = [&] {
+      std::lock_guard<std::mutex> lock(mu);
+      return have_status;
+    };
+    for (int i = 0; i < 50 && !heard(); ++i) wait_for_stop(std::chrono::milliseconds(100));
     {
       std::lock_guard<std::mutex> lock(mu);
       if (!have_status) throw std::runtime_error("no heartbeat from agent 0");

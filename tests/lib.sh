@@ -7,6 +7,9 @@ SRC="${DDSWARM_SRC:?DDSWARM_SRC must point at the source tree}"
 WORK="$(mktemp -d /tmp/ddswarm-test.XXXXXX)"
 # Each test uses its own DDS domain so parallel tests never see each other.
 DOMAIN="${DDSWARM_DOMAIN:-$(( (RANDOM % 200) + 20 ))}"
+# Sanitizer builds run several times slower: scale wall-clock bounds with slow N.
+SLOWDOWN="${DDSWARM_SLOWDOWN:-1}"
+slow() { echo $(( $1 * SLOWDOWN )); }
 declare -a PIDS=()
 declare -a NAMES=()
 
