@@ -49,7 +49,8 @@ void load(YamlSection s, DdsConfig& c) {
   s.finish();
 }
 
-int max_participant_id(int domain_id) { return (65535 - 7400 - 11 - 250 * domain_id) / 2; }
+int rtps_unicast_port(int domain_id, int participant_id) { return 7400 + 250 * domain_id + 10 + 2 * participant_id; }
+int max_participant_id(int domain_id) { return (65535 - 1 - rtps_unicast_port(domain_id, 0)) / 2; }
 
 void DdsConfig::validate() const {
   if (FILE* f = std::fopen(profiles_file.c_str(), "r")) {

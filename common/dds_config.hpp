@@ -22,6 +22,10 @@ enum class Discovery {
   kDiscoveryServer,  ///< opt-in: Fast DDS discovery server at ip:port
 };
 
+/// The RTPS metatraffic unicast port of a participant (the default port
+/// mapping: 7400 + 250*domain + 10 + 2*id); its user-data port is one above.
+int rtps_unicast_port(int domain_id, int participant_id);
+
 /// The largest RTPS participant id whose ports fit in domain_id (29062 at
 /// domain 0, 62 at domain 232). Fast DDS's automatic ids try only ~100.
 int max_participant_id(int domain_id);

@@ -224,8 +224,9 @@ int main(int argc, char** argv) {
     if (agent_hosts == 0 && !ids.empty() && agent_participant_id(n, ids.front()) >= 0) {
       int lo = 0, hi = -1;
       std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> lo >> hi;
-      const int domain = app.count("--domain") ? app.get_option("--domain")->as<int>() : file.dds.domain_id;
-      const std::string w = ephemeral_port_warning(domain, agent_participant_id(n, ids.front()),
+      DdsConfig dds = file.dds;
+      merge_cli(dds, dds_cli, app);
+      const std::string w = ephemeral_port_warning(dds.domain_id, agent_participant_id(n, ids.front()),
                                                    agent_participant_id(n, ids.back()), lo, hi);
       if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
     }

@@ -1,5 +1,7 @@
 #include "ground_station/launcher.hpp"
 
+#include "common/dds_config.hpp"
+
 #include <arpa/inet.h>
 #include <fmt/format.h>
 #include <fcntl.h>
@@ -270,10 +272,9 @@ int agent_participant_id(int drones, int drone_id) {
 }
 
 std::string ephemeral_port_warning(int domain, int first_id, int last_id, int lo, int hi) {
-  const auto port = [](int d, int id) { return 7400 + 250 * d + 10 + 2 * id; };
-  const int low = port(domain, first_id), high = port(domain, last_id) + 1;
+  const int low = rtps_unicast_port(domain, first_id), high = rtps_unicast_port(domain, last_id) + 1;
   if (first_id < 0 || last_id < first_id || high < lo || low > hi) return "";
-  const int clear_domain = (lo - 1 - port(0, last_id) - 1) / 250;  // largest d with every port below lo
+  const int clear_domain = (lo - 1 - rtps_unicast_port(0, last_id) - 1) / 250;  // largest d with every port below lo
   return fmt::format("participant ids {}-{} in domain {} use RTPS ports {}-{}, inside this machine's ephemeral "
                      "port range {}-{}: a participant whose port another socket holds is never discovered; "
                      "use --domain {} or lower",
