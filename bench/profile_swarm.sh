@@ -25,10 +25,9 @@ done
 command -v perf >/dev/null || { echo "profile_swarm: perf not installed (Debian linux-perf)" >&2; exit 2; }
 [ -n "$OUT" ] || OUT="$(mktemp -d /tmp/ddswarm-profile.XXXXXX)"
 mkdir -p "$OUT"
-# The thesis course, with ground-station timeouts a 128-process bring-up can meet.
+source "$SRC/bench/bench_lib.sh"
 SCENARIO="$OUT/profile_scenario.yaml"
-sed -e 's/^  ack_timeout_s: .*/  ack_timeout_s: 30.0\n  discovery_timeout_s: 60.0/' "$SRC/config/thesis_course.yaml" >"$SCENARIO"
-grep -q "discovery_timeout_s: 60.0" "$SCENARIO" || { echo "profile_swarm: cannot derive $SCENARIO" >&2; exit 2; }
+bench_scenario "$SCENARIO"
 LAUNCH_PID=""
 stop_launch() {
   [ -n "$LAUNCH_PID" ] || return 0
@@ -54,7 +53,7 @@ report() {  # report NAME DATA
 }
 
 for n in "${SIZES[@]}"; do
-  dom=$(( (RANDOM % 60) + 20 ))  # ports below the ephemeral range (launcher: ephemeral_port_warning)
+  dom=$(bench_domain)
   log="$OUT/$MODE-$n"
   mkdir -p "$log"
   "$BIN/ddswarm-launch" "$SCENARIO" --drones "$n" --mode "$MODE" --domain "$dom" --log-dir "$log" \

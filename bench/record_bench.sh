@@ -5,7 +5,8 @@
 set -u
 BIN="$1"; N="${2:-64}"; T="${3:-20}"
 SRC="$(cd "$(dirname "$0")/.." && pwd)"
-WORK="$(mktemp -d)"; DOMAIN=$(( (RANDOM % 100) + 120 ))
+source "$SRC/bench/bench_lib.sh"
+WORK="$(mktemp -d)"; DOMAIN=$(bench_domain)
 trap 'kill $SIM $REC 2>/dev/null; wait 2>/dev/null; rm -rf "$WORK"' EXIT
 "$BIN/ddswarm-sim" --scenario "$SRC/config/thesis_course.yaml" --drones "$N" --domain "$DOMAIN" \
   --duration $((T + 6)) >"$WORK/sim.log" 2>&1 & SIM=$!

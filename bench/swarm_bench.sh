@@ -75,11 +75,9 @@ if [ -z "$OUT" ]; then OUT="$(mktemp -d /tmp/ddswarm-bench.XXXXXX)"; TMP_OUT=1; 
 mkdir -p "$OUT"
 skip() { [[ ",$SKIP," == *",$1,"* ]]; }
 PY=/usr/bin/python3
-# The thesis course, with ground-station timeouts that a loaded machine and a
-# 128-process discovery can meet (the swarm's own settings are untouched).
+source "$SRC/bench/bench_lib.sh"
 SCENARIO="$OUT/bench_scenario.yaml"
-sed -e 's/^  ack_timeout_s: .*/  ack_timeout_s: 30.0\n  discovery_timeout_s: 60.0/' "$SRC/config/thesis_course.yaml" >"$SCENARIO"
-grep -q "discovery_timeout_s: 60.0" "$SCENARIO" || { echo "swarm_bench: cannot derive $SCENARIO" >&2; exit 2; }
+bench_scenario "$SCENARIO"
 
 LAUNCH_PID=""
 cleanup() {
@@ -124,7 +122,8 @@ RUN_TAG=""        # run_swarm's log directory suffix
 run_swarm() {
   local mode="$1" n="$2" secs="$3"
   local scenario="${RUN_SCENARIO:-$SCENARIO}"
-  local dom=$(( (RANDOM % 60) + 20 )) log="$OUT/$mode-$n$RUN_TAG"
+  local dom; dom=$(bench_domain)
+  local log="$OUT/$mode-$n$RUN_TAG"
   rm -rf "$log"; mkdir -p "$log"
   local bound=$(( secs + 400 ))
   local t0; t0=$(date +%s.%N)
@@ -297,7 +296,7 @@ if ! skip table1; then
   rm -rf "$T1"; mkdir -p "$T1"
   sed -e "s#^\( *scenario:\) *thesis_course.yaml#\1 $SRC/config/thesis_course.yaml#" \
       -e "s#^\( *runs_per_set:\) *[0-9]*#\1 $T1_RUNS#" "$SRC/config/table1.yaml" >"$T1/table1.yaml"
-  dom=$(( (RANDOM % 60) + 20 ))
+  dom=$(bench_domain)
   echo "swarm_bench: Table 1, 4 sets x $T1_RUNS runs (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
   t0=$(date +%s.%N)
   timeout $(( 60 * T1_RUNS + 300 )) "$BIN/ddswarm-gs" --domain "$dom" experiment "$T1/table1.yaml" --out "$T1/out" \

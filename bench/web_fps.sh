@@ -7,7 +7,8 @@
 set -u
 SRC="$(cd "$(dirname "$0")/.." && pwd)"
 BIN="${1:-$SRC/build/default/bin}"; N="${2:-128}"; T="${3:-10}"; MODE="${4:-mock}"
-WORK="$(mktemp -d)"; DOMAIN=$(( (RANDOM % 100) + 120 ))
+source "$SRC/bench/bench_lib.sh"
+WORK="$(mktemp -d)"; DOMAIN=$(bench_domain)
 PIDS=()
 trap 'for p in "${PIDS[@]}"; do kill $p 2>/dev/null; done; wait 2>/dev/null; rm -rf "$WORK"' EXIT
 if [ "$MODE" = "--real" ]; then
