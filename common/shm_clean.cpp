@@ -77,23 +77,29 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
   const std::set<std::string> present(names.begin(), names.end());
   std::set<std::string> mapped;
   bool have_mapped = false;
+  const auto is_mapped = [&](const std::string& name) {
+    if (!have_mapped) {
+      mapped = mapped_files(dir);
+      have_mapped = true;
+    }
+    return mapped.count(name) > 0;
+  };
   for (const auto& n : names) {
     if (starts_with(n, "fastrtps_") && (ends_with(n, "_el") || ends_with(n, "_sl"))) {
-      // A transport segment or port and its lock: owner alive <=> lock held.
-      if (locked(dir + "/" + n)) {
+      // A transport segment or port and its lock. Its owner alive <=> lock
+      // held; but a dead owner's port is still mapped by the live processes
+      // that send to it, and a restarted owner must reopen that same file
+      // (unlinked, the senders would push into a file nobody reads).
+      const std::string base = n.substr(0, n.size() - 3);
+      if (locked(dir + "/" + n) || is_mapped(base)) {
         ++r.in_use;
         continue;
       }
-      const std::string base = n.substr(0, n.size() - 3);
       remove(dir, base, r);
       remove(dir, n, r);
       if (starts_with(base, "fastrtps_port")) remove(dir, "sem." + base + "_mutex", r);
     } else if (starts_with(n, "fast_datasharing_")) {
-      if (!have_mapped) {
-        mapped = mapped_files(dir);
-        have_mapped = true;
-      }
-      if (mapped.count(n)) {
+      if (is_mapped(n)) {
         ++r.in_use;
         continue;
       }

@@ -6,7 +6,8 @@
 //
 // A file is a zombie only when no live process can be using it:
 //   fastrtps_<id> / fastrtps_port<N> (SHM transport): their "_el"/"_sl" lock
-//     file is not flock()ed by anyone (the owner holds it while alive);
+//     file is not flock()ed by anyone (the owner holds it while alive) and
+//     no process maps the file (senders map a port whose owner died);
 //   fast_datasharing_<guid>_<entity> (data-sharing pools): no process maps it
 //     (/proc/*/maps).
 // Files in use by any live process, of any domain or user, are never touched.

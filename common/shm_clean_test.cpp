@@ -74,3 +74,22 @@ TEST(ShmClean, KeepsWhatALiveProcessHolds) {
   close(sfd);
   close(fd);
 }
+
+TEST(ShmClean, KeepsADeadOwnersPortThatLiveSendersStillMap) {
+  // A killed server's port: nobody holds its lock, but the agents that send to
+  // it still map it, and the restarted server must reopen that same file.
+  TempDir d;
+  std::string port = d.touch("fastrtps_port7413");
+  d.touch("fastrtps_port7413_el", 0);
+  int fd = open(port.c_str(), O_RDWR);
+  ASSERT_GE(fd, 0);
+  void* m = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, fd, 0);
+  ASSERT_NE(m, MAP_FAILED);
+  auto r = clean_zombie_shm(d.path);
+  EXPECT_TRUE(d.has("fastrtps_port7413"));
+  EXPECT_TRUE(d.has("fastrtps_port7413_el"));
+  EXPECT_EQ(r.files_removed, 0);
+  EXPECT_EQ(r.in_use, 1);
+  munmap(m, 4096);
+  close(fd);
+}
