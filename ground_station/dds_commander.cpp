@@ -346,7 +346,12 @@ bool DdsCommander::wait_task_status(double timeout_s) {
 
 bool DdsCommander::attach_task(double timeout_s) {
   auto& I = *impl_;
-  bool ok = I.wait(timeout_s, [&] { return I.task && I.task->phase() != msg::TASK_NONE; });
+  auto has_task = [&] { return I.task && I.task->phase() != msg::TASK_NONE; };
+  // As in wait_task_status: on a loaded machine (a lockstep swarm busy on
+  // every core) our task reader can match the server's writer seconds after
+  // the status sample came, so the timeout for the task runs from the match.
+  I.wait(timeout_s, [&] { return has_task() || I.task_reader->matched() > 0; });
+  bool ok = I.wait(timeout_s, has_task);
   std::lock_guard<std::mutex> lock(I.mu);
   if (!ok || !I.task) return false;
   I.task_seq = I.task->seq();
