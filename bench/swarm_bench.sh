@@ -10,6 +10,9 @@
 #                      Fast DDS 2.9 and dds.participant_id's range leave some unreachable)
 #   --rt-sizes "..."   real-time counts (default: the same)
 #   --time S           lockstep seconds measured per N (default 10)
+#   --lockstep "plain pipelined"   lockstep variants per N: plain (each command flies the
+#                      step right after its state) and pipelined (sim.lockstep_pipeline:
+#                      physics runs while agents answer; commands act one tick later)
 #   --rt-time S        real-time seconds measured per N (default 60)
 #   --floor-time S     floor seconds measured per N (default 5)
 #   --skip floor,lockstep,realtime,hosts,table1   parts to leave out
@@ -42,6 +45,7 @@ HOSTS_K=2
 HOSTS_PHYS=250
 HOSTS_SENS=10
 T1_JOBS=2
+LS_VARIANTS="plain pipelined"
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) BIN="$2"; shift 2 ;;
@@ -61,7 +65,8 @@ while [ $# -gt 0 ]; do
     --hosts-sensors) HOSTS_SENS="$2"; shift 2 ;;
     --table1-jobs) T1_JOBS="$2"; shift 2 ;;
     --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; HOSTS_N=16; shift ;;
-    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
+    --lockstep) LS_VARIANTS="$2"; shift 2 ;;
+    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) echo "swarm_bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -180,18 +185,26 @@ field() {  # field KEY LINE
 if ! skip lockstep; then
   : >"$OUT/lockstep.txt"
   for n in $SIZES; do
-    echo "swarm_bench: lockstep N=$n (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
-    echo "$(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
+    for v in $LS_VARIANTS; do
+      case "$v" in
+        plain) RUN_EXTRA=(); RUN_TAG="" ;;
+        pipelined) RUN_EXTRA=(--set sim.lockstep_pipeline=true); RUN_TAG="-pipelined" ;;
+        *) echo "swarm_bench: unknown lockstep variant '$v' (plain, pipelined)" >&2; exit 2 ;;
+      esac
+      echo "swarm_bench: lockstep N=$n, $v (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
+      echo "variant=$v $(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
+    done
   done
+  RUN_EXTRA=(); RUN_TAG=""
   echo
   echo "== lockstep: ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes; ${LS_TIME} s measured while holding =="
-  echo "| N | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| N | variant | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   while read -r l; do
     n=$(field n "$l"); t=$(field ticks_per_s "$l"); f=$(field floor "$l")
     ratio=$(echo "$t $f" | awk '{ if ($1+0 > 0 && $2+0 > 0) printf "%.2f", $1 / $2; else print "-" }')
     rtf=$(echo "$t" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')
-    printf "| %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s |\n" "$n" "${t:--}" "$rtf" \
+    printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "${t:--}" "$rtf" \
       "$(echo "$f" | awk '{ printf "%.0f", $1 }')" "$ratio" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
       "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field rss_agent_mb "$l")" "$(field pss_agent_mb "$l")" \
       "$(field up_s "$l" | awk '{ printf "%.1f", $1 }')" "$(field load "$l")" \
@@ -252,11 +265,17 @@ fi
 # ---------------------------------------------------------------- plot
 if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   : >"$OUT/plot.dat"
-  while read -r l; do
-    t=$(field ticks_per_s "$l"); f=$(field floor "$l")
-    echo "$(field n "$l") ${t:-?} ${f:-?}" | sed 's/nan/?/g' |
-      awk '{ for (i = 2; i <= 3; ++i) if ($i != "?") $i = $i / 50; print }' >>"$OUT/plot.dat"
-  done <"$OUT/lockstep.txt"
+  # One row per N: plain, floor, pipelined (? where a variant was not run).
+  for n in $SIZES; do
+    t="?"; p="?"; f="?"
+    while read -r l; do
+      [ "$(field n "$l")" = "$n" ] || continue
+      f=$(field floor "$l")
+      case "$(field variant "$l")" in plain) t=$(field ticks_per_s "$l") ;; pipelined) p=$(field ticks_per_s "$l") ;; esac
+    done <"$OUT/lockstep.txt"
+    echo "$n ${t:-?} ${f:-?} ${p:-?}" | sed 's/nan/?/g' |
+      awk '{ for (i = 2; i <= 4; ++i) if ($i != "?") $i = $i / 50; print }' >>"$OUT/plot.dat"
+  done
   : >"$OUT/plot_rt.dat"
   [ -f "$OUT/realtime.txt" ] && while read -r l; do
     r=$(field rtf "$l")
@@ -276,6 +295,7 @@ set grid
 set key top right box opaque
 plot "$OUT/plot.dat" using 1:3 with linespoints lw 2 title "bare Fast DDS floor (ticks/s / 50)", \
      "$OUT/plot.dat" using 1:2 with linespoints lw 2 title "ddswarm lockstep (ticks/s / 50)", \
+     "$OUT/plot.dat" using 1:4 with linespoints lw 2 title "ddswarm lockstep, pipelined (ticks/s / 50)", \
      "$OUT/plot_rt.dat" using 1:2 with linespoints lw 2 title "ddswarm real time (paced, target 1)", \
      "-" using 1:2 with points pt 7 ps 1.6 title "gym-pybullet-drones: 10 at about 2x", \
      "-" using 1:2 with points pt 5 ps 1.6 title "SwarmLab: 16 at about 1x", \

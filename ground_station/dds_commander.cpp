@@ -236,17 +236,16 @@ bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
 }
 
 bool DdsCommander::wait_for_server(double timeout_s) {
-  // Acks written before an agent's writer matched our reader would be lost
-  // (volatile QoS), so every live agent should be matched before we speak.
-  const bool all = impl_->wait(timeout_s, [&] {
-    return impl_->sim && impl_->online_locked().size() >= impl_->sim->agents_live() &&
-           impl_->all_matched();
-  });
-  if (stop_requested()) return false;
-  // A frozen or unreachable agent never matches: go on once the server is
-  // there, and let the acknowledgements name whoever stays silent.
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  return all || (impl_->sim && impl_->w_mission.matched() > 0);
+  auto& I = *impl_;
+  auto everyone = [&] { return I.sim && I.online_locked().size() >= I.sim->agents_live() && I.all_matched(); };
+  // First the server, for up to the discovery timeout.
+  if (!I.wait(timeout_s, [&] { return everyone() || (I.sim && I.w_mission.matched() > 0); })) return false;
+  // Then every live agent's ack writer, for up to the ack timeout: an ack
+  // written before it matched our reader could be lost. A frozen or
+  // unreachable agent never matches, so go on after that and let the
+  // acknowledgements name whoever stays silent.
+  I.wait(I.cfg.ack_timeout_s, everyone);
+  return !stop_requested();
 }
 
 bool DdsCommander::wait_for_status(double timeout_s) {

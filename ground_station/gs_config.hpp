@@ -10,7 +10,7 @@ struct GroundStationConfig {
   std::string name = "gs";          ///< issuer name on mission commands
   double ack_timeout_s = 5.0;       ///< s wall: how long to wait for every live agent's ack
   double online_window_s = 1.5;     ///< s wall: an agent heard within this is online
-  double discovery_timeout_s = 5.0; ///< s wall: how long to wait for the server at start
+  double discovery_timeout_s = 10.0; ///< s wall: how long to wait for the server at start (docs/configuration.md: why 10)
   double task_timeout_s = 900.0;    ///< s wall: give up waiting for a task
   double server_timeout_s = 30.0;   ///< s wall: give up on a task whose server stays silent this long
   double max_input_speed_mps = 10;  ///< m/s, the console refuses faster moves

@@ -13,6 +13,7 @@ void load(YamlSection s, SimConfig& c) {
   s.get("agent_timeout_s", c.agent_timeout_s);
   s.get("max_command_speed_mps", c.max_command_speed_mps);
   s.get("pause_when_idle", c.pause_when_idle);
+  s.get("lockstep_pipeline", c.lockstep_pipeline);
   s.get("realtime_grace", c.realtime_grace);
   s.get("status_rate_hz", c.status_rate_hz);
   s.get("publish_per_drone_topics", c.publish_per_drone_topics);

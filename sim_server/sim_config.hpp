@@ -13,6 +13,7 @@ struct SimConfig {
   double agent_timeout_s = 1.0;         ///< s wall time: an agent silent this long is lost
   double max_command_speed_mps = 50.0;  ///< m/s: commands above are absurd and rejected (within: clamped)
   bool pause_when_idle = true;          ///< lockstep: hold the clock while every agent is idle
+  bool lockstep_pipeline = false;       ///< lockstep: step physics while agents answer; commands act one tick later
   double realtime_grace = 0.25;         ///< realtime: wait up to this fraction of a period past its end for late answers
   double status_rate_hz = 2.0;          ///< Hz wall, SimStatus publishing
   bool publish_per_drone_topics = true; ///< also publish keyed DroneState/DistanceScan

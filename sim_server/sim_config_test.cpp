@@ -26,6 +26,7 @@ TEST(ServerConfig, TheShippedScenarioLoads) {
   EXPECT_EQ(c.scenario.drones, 6);
   EXPECT_EQ(c.sim.substeps(), 20);
   EXPECT_GE(c.scene.cylinders.size(), 10u);
+  EXPECT_FALSE(c.sim.lockstep_pipeline);  // the thesis's lockstep: a command flies the step right after its state
 }
 
 TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
@@ -35,6 +36,8 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
   EXPECT_EQ(error_for("scene:\n  cylinders:\n    - {center_xy: [5, 5], radius_m: -2}\n"),
             "3: scene.cylinders[0].radius_m = -2: must be > 0");
   EXPECT_EQ(error_for("sim:\n  realtime_grace: 1.5\n"), "2: sim.realtime_grace = 1.5: must be in [0, 0.9]");
+  EXPECT_EQ(error_for("sim:\n  lockstep_pipeline: maybe\n"),
+            "2: sim.lockstep_pipeline = maybe: must be true or false");
   EXPECT_EQ(error_for("sim:\n  colour: red\n"), "2: sim.colour: unknown key");
   EXPECT_EQ(error_for("wings: 2\n"), "1: wings: unknown section");
   EXPECT_EQ(error_for("sensors:\n  count: many\n"), "2: sensors.count = many: must be an integer");

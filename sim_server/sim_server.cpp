@@ -77,6 +77,16 @@ struct Slot {
   double last_heard_wall = -1e9;
 };
 
+/// The part of a Slot that decides a drone's setpoint for one period.
+struct CommandView {
+  VelocitySetpoint setpoint;
+  bool has_command = false;
+  std::uint64_t command_tick = 0;
+  bool live = false;
+};
+
+CommandView view_of(const Slot& s) { return {s.setpoint, s.has_command, s.command_tick, s.live}; }
+
 }  // namespace
 
 struct SimServer::Impl {
@@ -84,6 +94,9 @@ struct SimServer::Impl {
   const int n;
   const double period_s;
   const double dt_s;
+  // Lockstep pipeline: physics for tick k -> k+1 runs while the agents answer
+  // tick k, with the commands that answered k-1 (latched when k went out).
+  const bool pipelined;
   std::vector<Eigen::Vector3d> starts;
   PhysicsWorld world;
   std::vector<FlightController> controllers;
@@ -108,6 +121,7 @@ struct SimServer::Impl {
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
+  bool live_changed = false;  // an agent came online or was lost since the last SimStatus
   int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
   double agent_d_int = 0;
   // Random per process: Scene and SimStatus carry it, so agents and ground
@@ -121,6 +135,7 @@ struct SimServer::Impl {
   std::vector<double> failsafe_since;  // sim time entered failsafe, <0 = not in failsafe
   std::vector<std::uint32_t> coll_obstacle, coll_drone, coll_ground;
   std::vector<float> cmd_age_s;
+  std::vector<CommandView> latched;  // pipelined: the answers to the tick before the published one
   std::deque<msg::MissionCommand> recent;
   double d_int = 0;
   msg::SwarmState swarm_msg;
@@ -146,6 +161,7 @@ struct SimServer::Impl {
         n(cfg.scenario.drones),
         period_s(1.0 / cfg.sim.control_rate_hz),
         dt_s(1.0 / cfg.sim.physics_rate_hz),
+        pipelined(cfg.sim.lockstep_pipeline && cfg.scenario.mode == TimeMode::kLockstep),
         starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
         world(cfg.scene, cfg.quadrotor, starts, cfg.scene.start.yaw_rad),
         referee(cfg.scene),
@@ -170,6 +186,7 @@ struct SimServer::Impl {
     coll_drone.assign(n, 0);
     coll_ground.assign(n, 0);
     cmd_age_s.assign(n, 0.f);
+    latched.resize(n);
     tick_live.assign(n, 0);
     tick_phase.assign(n, Phase::kIdle);
     positions.reserve(n);
@@ -285,6 +302,7 @@ struct SimServer::Impl {
       s.owner = instance;
       s.answered = false;
       ++unanswered;
+      live_changed = true;
     }
     s.last_heard_wall = wall_seconds();
   }
@@ -325,6 +343,7 @@ struct SimServer::Impl {
         s.live = false;
         s.owner = 0;
         if (!s.answered) --unanswered;
+        live_changed = true;
         counters.lockstep_timeouts(counters.lockstep_timeouts() + 1);
         spdlog::warn("drone {}: agent lost (silent for {:.1f} s); drone enters failsafe", i,
                      now - s.last_heard_wall);
@@ -372,11 +391,12 @@ struct SimServer::Impl {
 
   double sim_time() const { return static_cast<double>(tick) * period_s; }
 
-  /// Chooses each drone's setpoint for the coming period. Call with mu held.
+  /// Chooses each drone's setpoint for the coming period: from the latest
+  /// answers, or (pipelined) from those latched when the tick went out. Call with mu held.
   void select_setpoints() {
     const double t = sim_time();
     for (int i = 0; i < n; ++i) {
-      Slot& s = slots[i];
+      const CommandView s = pipelined ? latched[i] : view_of(slots[i]);
       bool fresh = s.has_command && s.live &&
                    (static_cast<double>(tick - std::min(tick, s.command_tick)) * period_s <=
                     cfg.sim.command_timeout_s);
@@ -506,7 +526,9 @@ struct SimServer::Impl {
       pending_beacons.clear();
       published_tick = tick;
       unanswered = 0;
-      for (auto& s : slots) {
+      for (int i = 0; i < n; ++i) {
+        Slot& s = slots[i];
+        if (pipelined) latched[i] = view_of(s);
         s.answered = false;
         unanswered += s.live;
       }
@@ -610,7 +632,12 @@ struct SimServer::Impl {
   }
   void publish_status(bool force) {
     double now = wall_seconds();
-    if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz) return;
+    if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz) {
+      // Who is live goes out at once: a ground station that has just heard
+      // every agent's heartbeat must not get a latched status listing none.
+      std::lock_guard<std::mutex> lock(mu);
+      if (!live_changed) return;
+    }
     double dw = now - rtf_wall;
     if (dw >= 0.5) {
       rtf = (sim_time() - rtf_sim) / dw;
@@ -622,6 +649,7 @@ struct SimServer::Impl {
     {
       std::lock_guard<std::mutex> lock(mu);
       s = counters;
+      live_changed = false;
       for (int i = 0; i < n; ++i)
         if (slots[i].live) s.live_agents().push_back(static_cast<std::uint16_t>(i));
       s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
@@ -649,15 +677,25 @@ struct SimServer::Impl {
     w_status.write(s);
   }
 
-  void advance() {
+  /// Steps the world one period with the setpoints select_setpoints picks.
+  void step() {
     {
       std::lock_guard<std::mutex> lock(mu);
       select_setpoints();
     }
     step_physics();
+  }
+
+  /// Publishes the next tick (the world already stepped to it).
+  void publish_next() {
     ++tick;
     publish_tick();
     publish_status(false);
+  }
+
+  void advance() {
+    step();
+    publish_next();
   }
 
   void run_realtime(double deadline_wall) {
@@ -699,7 +737,14 @@ struct SimServer::Impl {
   void run_lockstep(double deadline_wall) {
     publish_tick();
     double last_republish = wall_seconds();
+    bool ahead = false;  // pipelined: the world has stepped past the published tick
     while (!stop_requested() && wall_seconds() < deadline_wall) {
+      // Pipelined: step now, while the agents compute their answers to the
+      // published tick; those answers fly the step after this one.
+      if (pipelined && !ahead) {
+        step();
+        ahead = true;
+      }
       bool go = false;
       {
         std::unique_lock<std::mutex> lock(mu);
@@ -715,7 +760,12 @@ struct SimServer::Impl {
         if (paused != was_paused) last_status_wall = -1e9;
       }
       if (go) {
-        advance();
+        if (pipelined) {
+          publish_next();
+          ahead = false;
+        } else {
+          advance();
+        }
         last_republish = wall_seconds();
         continue;
       }
@@ -732,8 +782,9 @@ struct SimServer::Impl {
     start_wall = wall_seconds();
     rtf_wall = start_wall;
     double deadline = duration_s > 0 ? start_wall + duration_s : 1e300;
-    spdlog::info("ddswarm-sim: scenario '{}', {} drones, {} mode, physics {} Hz, control {} Hz, seed {}",
-                 cfg.scenario.name, n, to_string(cfg.scenario.mode), cfg.sim.physics_rate_hz,
+    spdlog::info("ddswarm-sim: scenario '{}', {} drones, {} mode{}, physics {} Hz, control {} Hz, seed {}",
+                 cfg.scenario.name, n, to_string(cfg.scenario.mode),
+                 pipelined ? " (pipelined: commands act one tick later)" : "", cfg.sim.physics_rate_hz,
                  cfg.sim.control_rate_hz, cfg.scenario.seed);
     if (cfg.scenario.mode == TimeMode::kLockstep)
       run_lockstep(deadline);

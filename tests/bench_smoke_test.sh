@@ -11,7 +11,9 @@ for title in "bare Fast DDS lockstep floor" "== lockstep:" "== real time:" "== T
 done
 # Each table has a row for N = 3 with a figure in it, and Table 1 its split.
 grep -Eq '^\| 3 \| simple \| [0-9]+ \|' "$out" || fail "floor row for N=3 missing or empty"
-grep -Eq '^\| 3 \| [0-9.]+ \| [0-9.]+ \|' "$out" || fail "lockstep row for N=3 missing or empty"
+for v in plain pipelined; do
+  grep -Eq "^\\| 3 \\| $v \\| [0-9.]+ \\| [0-9.]+ \\|" "$out" || fail "lockstep $v row for N=3 missing or empty"
+done
 grep -Eq '^\| 3 \| [0-9.]+ \| [0-9]+ / [0-9]+ / [0-9]+ \|' "$out" || fail "real-time row for N=3 missing or empty"
 grep -Eq '^\| task flight \| [0-9.]+ \|' "$out" || fail "Table 1 split missing"
 grep -q "4 runs, 0 failed" "$out" || fail "Table 1 quick runs failed"
