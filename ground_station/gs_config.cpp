@@ -12,6 +12,7 @@ void load(YamlSection s, GroundStationConfig& c) {
   s.get("max_input_speed_mps", c.max_input_speed_mps);
   s.get("max_input_time_s", c.max_input_time_s);
   s.get("results_csv", c.results_csv);
+  s.get("shared_memory", c.shared_memory);
   s.finish();
 }
 

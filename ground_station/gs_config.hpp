@@ -16,6 +16,7 @@ struct GroundStationConfig {
   double max_input_speed_mps = 10;  ///< m/s, the console refuses faster moves
   double max_input_time_s = 3600;   ///< s, the console refuses longer moves
   std::string results_csv;          ///< append each task's result here ("" = don't)
+  bool shared_memory = false;       ///< the ground station's own participants add SHM (docs/configuration.md: why not)
 
   void validate() const;
 };

@@ -173,6 +173,10 @@ int main(int argc, char** argv) {
     spdlog::set_level(spdlog::level::warn);
     auto file = load_gs_config(config);
     merge_cli(file.dds, dds_cli, app);
+    // A ground station is a short-lived process, one per command: over shared
+    // memory a new one took 1.5-3.2 s to hear the server right after another
+    // was killed; over loopback UDP, 0.15-0.25 s (docs/configuration.md).
+    if (!file.gs.shared_memory) file.dds.shared_memory = false;
     default_security_role(file.dds, "gs");
     file.dds.validate();
     install_stop_signals();

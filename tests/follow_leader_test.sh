@@ -29,6 +29,6 @@ awk -v a="$l0" -v b="$l1" 'BEGIN{exit !(b - a > 4.0)}' || fail "the leader did n
 awk -v c="$c0" -v d="$c1" 'BEGIN{exit !(d - c > 4.0)}' || fail "the followers stayed behind"
 awk -v b="$l1" -v d="$c1" 'BEGIN{x = b - d; if (x < 0) x = -x; exit !(x < 5.0)}' \
   || fail "the followers did not gather round their leader"
-gs hold >/dev/null || fail "hold after follow"
+out=$(gs hold 2>&1) || fail "hold after follow: $out"
 gs status --drones
 echo PASS
