@@ -450,8 +450,9 @@ struct AgentApp::Impl {
     ++b.sent;
   }
 
-  void run(double duration_s) {
-    double end = duration_s > 0 ? wall_seconds() + duration_s : 1e300;
+  AgentApp::End run(double duration_s) {
+    const double joined = wall_seconds();
+    double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
     else
@@ -466,14 +467,23 @@ struct AgentApp::Impl {
           spdlog::warn("{}: no server samples for {:.1f} s; holding commands until it returns",
                        label, silent);
         }
+        // Fast DDS 2.9 sometimes never matches one of 128 participants that
+        // start at once (docs/performance.md); a new participant is
+        // discovered afresh. No scene also means no mission to lose.
+        if (!scene && cfg.agent.rejoin_after_s > 0 && wall_seconds() - joined > cfg.agent.rejoin_after_s) {
+          spdlog::warn("{}: no scene within {:.0f} s; leaving DDS and joining again as a new participant",
+                       label, cfg.agent.rejoin_after_s);
+          return AgentApp::End::kNoScene;
+        }
       }
       wait_for_stop(std::chrono::milliseconds(250));
     }
+    return AgentApp::End::kStopped;
   }
 };
 
 AgentApp::AgentApp(AgentAppConfig cfg) : impl_(std::make_unique<Impl>(std::move(cfg))) {}
 AgentApp::~AgentApp() = default;
-void AgentApp::run(double duration_s) { impl_->run(duration_s); }
+AgentApp::End AgentApp::run(double duration_s) { return impl_->run(duration_s); }
 
 }  // namespace ddswarm::agent

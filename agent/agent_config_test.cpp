@@ -117,6 +117,10 @@ TEST(AgentConfig, BadEnumNamesTheChoices) {
 TEST(AgentConfig, ValidationErrorsNameTheField) {
   EXPECT_EQ(error_of("agent:\n  inter_distance_m: -4\n"),
             "s.yaml:2: agent.inter_distance_m = -4: must be > 0");
+  // Re-joining DDS needs time to discover first: 0 (never) or at least 2 s.
+  EXPECT_EQ(error_of("agent:\n  rejoin_after_s: 0.5\n"),
+            "s.yaml:2: agent.rejoin_after_s = 0.5: must be in [2, 3600]");
+  EXPECT_EQ(error_of("agent:\n  rejoin_after_s: 0\n"), "");
   EXPECT_NE(
       error_of("agent:\n  activation:\n    repulsion_gain: 0.1\n")
           .find("s.yaml:3: agent.activation.repulsion_gain = 0.1: must be >= attraction_gain"),

@@ -65,8 +65,14 @@ int main(int argc, char** argv) {
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
     ddswarm::install_stop_signals();
     try {
-      ddswarm::agent::AgentApp agent(std::move(cfg));
-      agent.run(duration_s);
+      using ddswarm::agent::AgentApp;
+      const double end = duration_s > 0 ? ddswarm::wall_seconds() + duration_s : 0;
+      while (!ddswarm::stop_requested()) {  // a new participant each time no scene came (agent.rejoin_after_s)
+        const double left = end > 0 ? end - ddswarm::wall_seconds() : 0;
+        if (end > 0 && left <= 0) break;
+        AgentApp agent(cfg);
+        if (agent.run(left) == AgentApp::End::kStopped) break;
+      }
     } catch (const ddswarm::agent::DuplicateAgent& e) {
       std::fprintf(stderr, "ddswarm-agent: error: %s\n", e.what());
       return 3;
