@@ -452,6 +452,10 @@ struct AgentApp::Impl {
 
   AgentApp::End run(double duration_s) {
     const double joined = wall_seconds();
+    // Up to half as long again, different in every process: when a whole
+    // swarm missed the server, its agents must not all re-join at once.
+    const double patience =
+        cfg.agent.rejoin_after_s * (1.0 + 0.5 * static_cast<double>(brains[0]->instance % 1024) / 1024.0);
     double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
@@ -470,9 +474,9 @@ struct AgentApp::Impl {
         // Fast DDS 2.9 sometimes never matches one of 128 participants that
         // start at once (docs/performance.md); a new participant is
         // discovered afresh. No scene also means no mission to lose.
-        if (!scene && cfg.agent.rejoin_after_s > 0 && wall_seconds() - joined > cfg.agent.rejoin_after_s) {
-          spdlog::warn("{}: no scene within {:.0f} s; leaving DDS and joining again as a new participant",
-                       label, cfg.agent.rejoin_after_s);
+        if (!scene && cfg.agent.rejoin_after_s > 0 && wall_seconds() - joined > patience) {
+          spdlog::warn("{}: no scene within {:.1f} s; leaving DDS and joining again as a new participant",
+                       label, patience);
           return AgentApp::End::kNoScene;
         }
       }
