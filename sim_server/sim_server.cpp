@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -121,7 +122,9 @@ struct SimServer::Impl {
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
-  bool live_changed = false;  // an agent came online or was lost since the last SimStatus
+  // An agent came online or was lost since the last SimStatus. Set under mu;
+  // atomic so the per-tick check in publish_status needs no lock.
+  std::atomic<bool> live_changed{false};
   int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
   double agent_d_int = 0;
   // Random per process: Scene and SimStatus carry it, so agents and ground
@@ -632,12 +635,11 @@ struct SimServer::Impl {
   }
   void publish_status(bool force) {
     double now = wall_seconds();
-    if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz) {
-      // Who is live goes out at once: a ground station that has just heard
-      // every agent's heartbeat must not get a latched status listing none.
-      std::lock_guard<std::mutex> lock(mu);
-      if (!live_changed) return;
-    }
+    // Who is live goes out at once: a ground station that has just heard
+    // every agent's heartbeat must not get a latched status listing none.
+    if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz &&
+        !live_changed.load(std::memory_order_relaxed))
+      return;
     double dw = now - rtf_wall;
     if (dw >= 0.5) {
       rtf = (sim_time() - rtf_sim) / dw;
