@@ -143,6 +143,16 @@ struct DdsCommander::Impl {
     return !stop_requested();
   }
 
+  /// The task status is latched: once our reader has matched the server's
+  /// writer, its last sample follows. On a loaded machine (a lockstep swarm
+  /// busy on every core) the match can come seconds after the server's first
+  /// status, so wait up to match_s for the match, then up to sample_s for done().
+  template <class Pred>
+  bool wait_latched_task(double match_s, double sample_s, Pred done) {
+    wait(match_s, [&] { return done() || task_reader->matched() > 0; });
+    return wait(sample_s, done);
+  }
+
   /// The server hears our commands and every online agent's acks reach us. mu held.
   bool all_matched() const {
     // One ack writer per agent process; an agent host flies many drones.
@@ -336,21 +346,12 @@ CommandResult DdsCommander::task(double speed, double eps) {
 }
 
 bool DdsCommander::wait_task_status(double timeout_s) {
-  // Latched: once our reader has matched the server's writer, its last
-  // sample (if it ever wrote one) follows at once. Matching can lag the
-  // status sample on a loaded machine, so wait for the match first.
-  impl_->wait(timeout_s, [&] { return impl_->task.has_value() || impl_->task_reader->matched() > 0; });
-  return impl_->wait(1.0, [&] { return impl_->task.has_value(); });
+  return impl_->wait_latched_task(timeout_s, 1.0, [&] { return impl_->task.has_value(); });
 }
 
 bool DdsCommander::attach_task(double timeout_s) {
   auto& I = *impl_;
-  auto has_task = [&] { return I.task && I.task->phase() != msg::TASK_NONE; };
-  // As in wait_task_status: on a loaded machine (a lockstep swarm busy on
-  // every core) our task reader can match the server's writer seconds after
-  // the status sample came, so the timeout for the task runs from the match.
-  I.wait(timeout_s, [&] { return has_task() || I.task_reader->matched() > 0; });
-  bool ok = I.wait(timeout_s, has_task);
+  bool ok = I.wait_latched_task(timeout_s, timeout_s, [&] { return I.task && I.task->phase() != msg::TASK_NONE; });
   std::lock_guard<std::mutex> lock(I.mu);
   if (!ok || !I.task) return false;
   I.task_seq = I.task->seq();
