@@ -29,6 +29,20 @@ struct TempDir {
   bool has(const std::string& name) const { return access((path + "/" + name).c_str(), F_OK) == 0; }
 };
 
+/// Maps a file as a live process that uses it does (listed in /proc/self/maps).
+struct Mapping {
+  int fd;
+  void* m = MAP_FAILED;
+  explicit Mapping(const std::string& path) : fd(open(path.c_str(), O_RDWR)) {
+    if (fd >= 0) m = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, fd, 0);
+  }
+  ~Mapping() {
+    if (m != MAP_FAILED) munmap(m, 4096);
+    if (fd >= 0) close(fd);
+  }
+  bool ok() const { return m != MAP_FAILED; }
+};
+
 }  // namespace
 
 TEST(ShmClean, RemovesTransportSegmentsAndPortsWhoseOwnerIsGone) {
@@ -56,11 +70,8 @@ TEST(ShmClean, KeepsWhatALiveProcessHolds) {
   ASSERT_GE(fd, 0);
   ASSERT_EQ(flock(fd, LOCK_EX), 0);  // as the owning participant does while it lives
 
-  std::string seg = d.touch("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.00_0.0.1.4");
-  int sfd = open(seg.c_str(), O_RDWR);
-  ASSERT_GE(sfd, 0);
-  void* m = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, sfd, 0);
-  ASSERT_NE(m, MAP_FAILED);
+  Mapping seg(d.touch("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.00_0.0.1.4"));
+  ASSERT_TRUE(seg.ok());
   d.touch("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.01_0.0.1.4");  // nobody maps it
 
   auto r = clean_zombie_shm(d.path);
@@ -70,8 +81,6 @@ TEST(ShmClean, KeepsWhatALiveProcessHolds) {
   EXPECT_FALSE(d.has("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.01_0.0.1.4"));
   EXPECT_EQ(r.files_removed, 1);
   EXPECT_EQ(r.in_use, 2);
-  munmap(m, 4096);
-  close(sfd);
   close(fd);
 }
 
@@ -79,17 +88,12 @@ TEST(ShmClean, KeepsADeadOwnersPortThatLiveSendersStillMap) {
   // A killed server's port: nobody holds its lock, but the agents that send to
   // it still map it, and the restarted server must reopen that same file.
   TempDir d;
-  std::string port = d.touch("fastrtps_port7413");
+  Mapping port(d.touch("fastrtps_port7413"));
+  ASSERT_TRUE(port.ok());
   d.touch("fastrtps_port7413_el", 0);
-  int fd = open(port.c_str(), O_RDWR);
-  ASSERT_GE(fd, 0);
-  void* m = mmap(nullptr, 4096, PROT_READ, MAP_SHARED, fd, 0);
-  ASSERT_NE(m, MAP_FAILED);
   auto r = clean_zombie_shm(d.path);
   EXPECT_TRUE(d.has("fastrtps_port7413"));
   EXPECT_TRUE(d.has("fastrtps_port7413_el"));
   EXPECT_EQ(r.files_removed, 0);
   EXPECT_EQ(r.in_use, 1);
-  munmap(m, 4096);
-  close(fd);
 }
