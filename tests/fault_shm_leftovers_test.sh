@@ -4,8 +4,6 @@
 # segments); the next server clears the zombies (as `fastdds shm clean`
 # does, plus data-sharing pools) and the next swarm flies on the same domain.
 source "$(dirname "$0")/lib.sh"
-# The ThreadSanitizer build talks UDP only: no segments to leave behind.
-[ -n "${DDSWARM_NO_SHM:-}" ] && { echo "SKIP: this build uses no shared memory (DDSWARM_NO_SHM)"; exit 77; }
 scenario="$SRC/config/thesis_course.yaml"
 gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
 start sim1 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
