@@ -180,6 +180,10 @@ run_swarm() {
 field() {  # field KEY LINE
   echo "$2" | tr ' ' '\n' | sed -n "s/^$1=//p" | head -1
 }
+# The cells every swarm table formats the same way, from a run_swarm line.
+up_cell() { field up_s "$1" | awk '{ printf "%.1f", $1 }'; }
+missed_cell() { field missed_frac "$1" | awk '{ if ($1 != "") printf "%.3f %%", 100 * $1; else print "-" }'; }
+note_cell() { echo "$1" | sed -n 's/.*why="\([^"]*\)".*/\1/p'; }
 
 # ---------------------------------------------------------------- lockstep
 if ! skip lockstep; then
@@ -207,8 +211,8 @@ if ! skip lockstep; then
     printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "${t:--}" "$rtf" \
       "$(echo "$f" | awk '{ printf "%.0f", $1 }')" "$ratio" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
       "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field rss_agent_mb "$l")" "$(field pss_agent_mb "$l")" \
-      "$(field up_s "$l" | awk '{ printf "%.1f", $1 }')" "$(field load "$l")" \
-      "$(echo "$l" | sed -n 's/.*why="\([^"]*\)".*/\1/p')"
+      "$(up_cell "$l")" "$(field load "$l")" \
+      "$(note_cell "$l")"
   done <"$OUT/lockstep.txt"
 fi
 
@@ -230,12 +234,12 @@ if ! skip realtime; then
     [ "$ok" = yes ] && [ "$n" -gt "$best" ] && best=$n
     printf "| %s | %s | %s / %s / %s | %s (%s of %s) | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" \
       "$n" "${rtf:--}" "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
-      "$(echo "${mf:-}" | awk '{ if ($1 != "") printf "%.3f %%", 100 * $1; else print "-" }')" \
+      "$(missed_cell "$l")" \
       "$(field missed "$l")" "$(field drone_ticks "$l")" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
       "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field cpu_probe "$l")" "$(field rss_agent_mb "$l")" \
-      "$(field pss_agent_mb "$l")" "$(field up_s "$l" | awk '{ printf "%.1f", $1 }')" \
+      "$(field pss_agent_mb "$l")" "$(up_cell "$l")" \
       "$(field floor "$l" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')" "$ok" \
-      "$(field load "$l")" "$(echo "$l" | sed -n 's/.*why="\([^"]*\)".*/\1/p')"
+      "$(field load "$l")" "$(note_cell "$l")"
   done <"$OUT/realtime.txt"
   echo "largest N meeting the real-time criteria: $best"
 fi
@@ -249,17 +253,17 @@ if ! skip hosts; then
   l="$(run_swarm realtime "$HOSTS_N" "$RT_TIME") load=$(cut -d' ' -f1 /proc/loadavg)"
   RUN_SCENARIO=""; RUN_EXTRA=(); RUN_TAG=""
   echo "$l" >"$OUT/hosts.txt"
-  rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l"); mf=$(field missed_frac "$l")
+  rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l")
   echo
   echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, ${RT_TIME} s =="
   echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | host RSS (MB) | bring-up + discovery (s) | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|"
   printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
     "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
-    "$(echo "${mf:-}" | awk '{ if ($1 != "") printf "%.3f %%", 100 * $1; else print "-" }')" \
+    "$(missed_cell "$l")" \
     "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" "$(field cpu_agent_each "$l")" "$(field rss_agent_mb "$l")" \
-    "$(field up_s "$l" | awk '{ printf "%.1f", $1 }')" "$(field load "$l")" \
-    "$(echo "$l" | sed -n 's/.*why="\([^"]*\)".*/\1/p')"
+    "$(up_cell "$l")" "$(field load "$l")" \
+    "$(note_cell "$l")"
 fi
 
 # ---------------------------------------------------------------- plot
