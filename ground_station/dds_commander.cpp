@@ -245,6 +245,14 @@ bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
   });
 }
 
+bool DdsCommander::wait_for_online(int count, double timeout_s) {
+  return impl_->wait(timeout_s, [&] {
+    if (!impl_->sim) return false;
+    int want = count >= 0 ? count : impl_->sim->num_drones();
+    return impl_->online_locked().size() >= static_cast<std::size_t>(want);
+  });
+}
+
 bool DdsCommander::wait_for_server(double timeout_s) {
   auto& I = *impl_;
   auto everyone = [&] { return I.sim && I.online_locked().size() >= I.sim->agents_live() && I.all_matched(); };

@@ -38,6 +38,11 @@ class DdsCommander final : public Commander {
   /// Waits until the server is heard and count agents are online (count < 0:
   /// as many as the server's scenario has). Returns false on timeout.
   bool wait_for_swarm(int count, double timeout_s);
+  /// Waits until the server is heard and count agents are online in its view
+  /// (count < 0: as many as the scenario has), without waiting for this
+  /// process's own connections to each agent: for `wait-agents`, whose
+  /// process exits right after. Returns false on timeout.
+  bool wait_for_online(int count, double timeout_s);
   /// Waits until the server's status is heard, the mission writer is matched,
   /// and a heartbeat has arrived from every agent the server hears.
   bool wait_for_server(double timeout_s);

@@ -225,7 +225,9 @@ int main(int argc, char** argv) {
       return run_menu(gs, reader, std::cout, mo);
     }
     if (*wait_agents) {
-      bool ok = gs.wait_for_swarm(wait_count, wait_timeout);
+      // The server's view decides: the next command is another process, which
+      // waits for its own connections to the agents (wait_for_server).
+      bool ok = gs.wait_for_online(wait_count, wait_timeout);
       auto st = gs.status();
       std::printf("%d/%d agents online\n", st.drones_online, st.drones_total);
       return ok ? 0 : 1;
