@@ -36,6 +36,9 @@ void ActivationConfig::validate() const {
                          "): repulsion must be the stronger force for the drones' safety");
   check_positive(p + ".max_mps", max_mps);
   check_non_negative(p + ".cutoff_m", cutoff_m);
+  if (neighbours < 0 || neighbours > kMaxNeighbours)
+    throw FieldError(p + ".neighbours", std::to_string(neighbours),
+                     "must be 0 (every peer) or 1.." + std::to_string(kMaxNeighbours));
   if (type == ActivationType::kLinear) {
     if (!points.empty())
       throw FieldError(p + ".points", std::to_string(points.size()) + " points",
@@ -134,6 +137,7 @@ void load(YamlSection s, ActivationConfig& c) {
   s.get("max_mps", c.max_mps);
   s.get("points", c.points);
   s.get("cutoff_m", c.cutoff_m);
+  s.get("neighbours", c.neighbours);
   s.finish();
 }
 

@@ -14,6 +14,8 @@ namespace ddswarm::agent {
 
 enum class ActivationType { kLinear, kCustom };
 
+inline constexpr int kMaxNeighbours = 64;  ///< largest agent.activation.neighbours
+
 /// The drone-to-drone activation f_rel(D_r), D_r = |d_i - d_j| - D_int
 /// (thesis §2.4.1, Fig. 3/5). YAML `agent.activation`.
 struct ActivationConfig {
@@ -25,6 +27,9 @@ struct ActivationConfig {
   /// f < 0 where D_r < 0 and f > 0 where D_r > 0; held flat beyond the ends.
   std::vector<Eigen::Vector2d> points;
   double cutoff_m = 0.0;  ///< m, peers farther than this are ignored; 0 = no cutoff; else > D_int
+  /// Topological neighbourhood: only the k nearest peers (within cutoff_m)
+  /// act on a drone; 0 = every peer (the thesis's Eq. 3.2). [0, kMaxNeighbours].
+  int neighbours = 0;
 
   void validate() const;  ///< throws FieldError("agent.activation.…")
 };

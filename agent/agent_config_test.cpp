@@ -63,6 +63,7 @@ agent:
     points: [[-3, -2], [0, 0], [2, 0.5]]
     max_mps: 2
     cutoff_m: 12
+    neighbours: 7
   sensor_function:
     type: custom
     points: [[0.5, 3], [2, 1], [5, 0]]
@@ -85,6 +86,7 @@ agent:
   EXPECT_EQ(c.activation.points[0], Eigen::Vector2d(-3, -2));
   EXPECT_EQ(c.activation.max_mps, 2);
   EXPECT_EQ(c.activation.cutoff_m, 12);
+  EXPECT_EQ(c.activation.neighbours, 7);
   EXPECT_EQ(c.sensor_function.type, SensorFunctionType::kCustom);
   EXPECT_EQ(c.sensor_function.points.back(), Eigen::Vector2d(5, 0));
   EXPECT_EQ(c.sensor_function.safety_distance_m, 0.8);
@@ -131,6 +133,8 @@ TEST(AgentConfig, ValidationErrorsNameTheField) {
   EXPECT_NE(
       error_of("agent:\n  activation:\n    cutoff_m: 3\n").find("agent.activation.cutoff_m = 3"),
       std::string::npos);
+  EXPECT_EQ(error_of("agent:\n  activation:\n    neighbours: -1\n"),
+            "s.yaml:3: agent.activation.neighbours = -1: must be 0 (every peer) or 1..64");
   EXPECT_NE(error_of("agent:\n  min_altitude_m: 3\n").find("agent.takeoff_altitude_m = 2"),
             std::string::npos);
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace ddswarm::agent {
 namespace {
@@ -45,12 +47,27 @@ Eigen::Vector3d repulsion_attraction(const Eigen::Vector3d& self,
                                      std::span<const Eigen::Vector3d> peers, double d_int,
                                      const ActivationConfig& a) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const auto& p : peers) {
-    const Eigen::Vector3d delta = p - self;
-    const double dist = delta.norm();
-    if (!(dist > kTiny)) continue;
-    if (a.cutoff_m > 0 && dist > a.cutoff_m) continue;
-    c += f_rel(dist - d_int, a) * (delta / dist);
+  auto acts = [&](double dist) { return dist > kTiny && !(a.cutoff_m > 0 && dist > a.cutoff_m); };
+  const auto k = static_cast<std::size_t>(std::max(a.neighbours, 0));
+  if (k == 0 || peers.size() <= k) {
+    for (const auto& p : peers) {
+      const Eigen::Vector3d delta = p - self;
+      const double dist = delta.norm();
+      if (acts(dist)) c += f_rel(dist - d_int, a) * (delta / dist);
+    }
+    return c;
+  }
+  // The k nearest: (distance, index) of every acting peer, partly sorted.
+  // Ties go to the lower index, so the choice depends on the input alone.
+  thread_local std::vector<std::pair<double, std::size_t>> near;
+  near.clear();
+  for (std::size_t j = 0; j < peers.size(); ++j)
+    if (const double dist = (peers[j] - self).norm(); acts(dist)) near.emplace_back(dist, j);
+  const std::size_t n = std::min(k, near.size());
+  if (near.size() > n) std::nth_element(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d delta = peers[near[i].second] - self;
+    c += f_rel(near[i].first - d_int, a) * (delta / near[i].first);
   }
   return c;
 }

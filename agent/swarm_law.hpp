@@ -51,7 +51,17 @@ double f_rel(double d_r, const ActivationConfig& a);
 
 /// C_i (m/s, world): sum over peers of f_rel(|d_i - d_j| - d_int) * unit(d_j - d_i).
 /// Peers beyond a.cutoff_m (when > 0) are ignored; a peer at self's position
-/// (closer than 1e-9 m) has no direction and contributes nothing.
+/// (closer than 1e-9 m) has no direction and contributes nothing. With
+/// a.neighbours = k > 0 only the k nearest of the remaining peers act (equal
+/// distances: the earlier peer in the span).
+///
+/// Why k nearest (a topological neighbourhood, as starlings keep about seven
+/// neighbours: Ballerini et al., PNAS 2008): in the thesis's sum every peer
+/// attracts, so a drone's pull toward the centre grows with n while the
+/// push from its closest peer is capped at max_mps. From about 10 drones the
+/// swarm packs tighter than 1 m and, at 32 and more, drones touch. With k
+/// neighbours the pull is bounded by k terms however large the swarm, and a
+/// drone whose k nearest are all closer than D_int is pushed outward.
 Eigen::Vector3d repulsion_attraction(const Eigen::Vector3d& self,
                                      std::span<const Eigen::Vector3d> peers, double d_int,
                                      const ActivationConfig& a);

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <functional>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -130,6 +132,99 @@ TEST(RepulsionAttraction, SumsPeersSkipsCoincidentAndCutoff) {
   EXPECT_NEAR(c.x(), 0.5, 1e-12);
   a.cutoff_m = 5;  // the peer 6 m away is out of range
   EXPECT_EQ(repulsion_attraction(self, peers, 4, a), Vector3d::Zero());
+}
+
+TEST(RepulsionAttraction, NeighboursTakesOnlyTheKNearestPeers) {
+  ActivationConfig a;
+  const Vector3d self(0, 0, 2);
+  // Two close peers push, two far ones pull harder than they push.
+  const std::vector<Vector3d> peers = {{9, 0, 2}, {0, 3, 2}, {-3, 0, 2}, {0, -10, 2}};
+  const Vector3d all = repulsion_attraction(self, peers, 4, a);
+  a.neighbours = 2;
+  const Vector3d near2 = repulsion_attraction(self, peers, 4, a);
+  // Only (0, 3) and (-3, 0) act: each pushes 1 m/s away from it.
+  EXPECT_NEAR(near2.x(), 1.0, 1e-12);
+  EXPECT_NEAR(near2.y(), -1.0, 1e-12);
+  EXPECT_GT((all - near2).norm(), 1.0) << "the far peers did act in the full sum";
+  a.neighbours = 4;  // as many as there are: the thesis's sum
+  EXPECT_EQ(repulsion_attraction(self, peers, 4, a), all);
+  // The cutoff applies first: of the peers within 5 m, k = 3 leaves both.
+  a.neighbours = 3;
+  a.cutoff_m = 5;
+  EXPECT_EQ(repulsion_attraction(self, peers, 4, a), near2);
+  // Equal distances: the earlier peer in the span wins, whatever the order of the rest.
+  a = ActivationConfig{};
+  a.neighbours = 1;
+  const std::vector<Vector3d> tie = {{20, 0, 2}, {0, 2, 2}, {2, 0, 2}};
+  EXPECT_NEAR(repulsion_attraction(self, tie, 4, a).y(), -1.5, 1e-12);
+}
+
+namespace {
+
+struct Packing {
+  double closest = 1e9;        ///< m, closest pair
+  double widest_gap = 0;       ///< m, the farthest any drone is from its nearest peer
+  bool connected = false;      ///< every drone within 1.5 D_int of the rest, transitively
+};
+
+/// Flies n drones from a square start grid (spacing m apart, one altitude) on
+/// the swarm term alone, kinematically (x += v dt, 20 Hz), for t_s seconds.
+Packing settle(int n, double spacing, const AgentConfig& c, double t_s) {
+  std::vector<Vector3d> p;
+  const int side = static_cast<int>(std::ceil(std::sqrt(n)));
+  for (int i = 0; i < n; ++i) p.emplace_back(spacing * (i % side), spacing * (i / side), 2.0);
+  const double dt = 0.05;
+  std::vector<Vector3d> peers, v(p.size());
+  for (int step = 0; step < static_cast<int>(t_s / dt); ++step) {
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      peers.clear();
+      for (std::size_t j = 0; j < p.size(); ++j)
+        if (j != i) peers.push_back(p[j]);
+      LawInput in;
+      in.p_world = p[i];
+      in.peers_world = peers;
+      v[i] = control_velocity(in, c);
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] += dt * v[i];
+  }
+  Packing k;
+  std::vector<int> comp(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) comp[i] = static_cast<int>(i);
+  std::function<int(int)> root = [&](int i) { return comp[i] == i ? i : comp[i] = root(comp[i]); };
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    double nearest = 1e9;
+    for (std::size_t j = 0; j < p.size(); ++j) {
+      if (i == j) continue;
+      const double d = (p[i] - p[j]).norm();
+      nearest = std::min(nearest, d);
+      if (d < 1.5 * c.inter_distance_m) comp[root(static_cast<int>(i))] = root(static_cast<int>(j));
+    }
+    k.closest = std::min(k.closest, nearest);
+    k.widest_gap = std::max(k.widest_gap, nearest);
+  }
+  k.connected = true;
+  for (std::size_t i = 0; i < p.size(); ++i) k.connected = k.connected && root(static_cast<int>(i)) == root(0);
+  return k;
+}
+
+}  // namespace
+
+TEST(DenseSwarm, EveryPeerPacksThirtyTwoDronesTightKNearestKeepsThemApart) {
+  // 32 drones from the thesis course's 2 m start grid, 60 s on the swarm law.
+  AgentConfig thesis;
+  const Packing sum = settle(32, 2.0, thesis, 60);
+  // The thesis's sum: 31 peers pull, one pushes at most max_mps. Drones
+  // about 0.5 m across touch well before this.
+  EXPECT_LT(sum.closest, 1.0);
+  AgentConfig topo;
+  topo.activation.neighbours = 6;
+  const Packing k6 = settle(32, 2.0, topo, 60);
+  std::printf("32 drones after 60 s: every peer: closest pair %.2f m; 6 nearest: closest %.2f m, "
+              "widest nearest-neighbour gap %.2f m\n",
+              sum.closest, k6.closest, k6.widest_gap);
+  EXPECT_GT(k6.closest, 0.6 * topo.inter_distance_m) << "k nearest keep clear of each other";
+  EXPECT_LT(k6.widest_gap, 1.25 * topo.inter_distance_m) << "and near their neighbours";
+  EXPECT_TRUE(k6.connected) << "one swarm, not islands";
 }
 
 // ---- sensor functions ------------------------------------------------------------------------
