@@ -177,3 +177,17 @@ TEST(AgentConfig, CustomSensorCurveIsChecked) {
                 .find("agent.sensor_function.safety_distance_m = -1: must be >= 0"),
             std::string::npos);
 }
+
+TEST(AgentConfig, ShippedScenariosLoad) {
+  for (const char* name : {"thesis_course.yaml", "swarm_field.yaml"}) {
+    SCOPED_TRACE(name);
+    auto doc = YamlDocument::load_file(std::string(DDSWARM_CONFIG_DIR) + "/" + name);
+    AgentConfig c;
+    EXPECT_NO_THROW(doc.guard([&] {
+      load(doc.section("agent"), c);
+      c.validate();
+    }));
+    // The large field flies the law for dense swarms; the course, the thesis's.
+    EXPECT_EQ(c.activation.neighbours, std::string(name) == "swarm_field.yaml" ? 6 : 0);
+  }
+}

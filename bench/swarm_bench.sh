@@ -174,7 +174,9 @@ run_swarm() {
   kill -KILL "$LAUNCH_PID" 2>/dev/null
   wait "$LAUNCH_PID" 2>/dev/null
   LAUNCH_PID=""
-  echo "mode=$mode n=$n up_s=$up ds=${addr:-none} why=\"$why\" $line"
+  # Drone-drone contacts begun in the whole run (take-off included): the sim logs each one.
+  local contacts; contacts=$(grep -c "collision: drone [0-9]* with drone" "$log/sim.log" 2>/dev/null)
+  echo "mode=$mode n=$n up_s=$up ds=${addr:-none} contacts=${contacts:-0} why=\"$why\" $line"
 }
 
 field() {  # field KEY LINE
@@ -202,16 +204,16 @@ if ! skip lockstep; then
   RUN_EXTRA=(); RUN_TAG=""
   echo
   echo "== lockstep: ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes; ${LS_TIME} s measured while holding =="
-  echo "| N | variant | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| N | variant | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   while read -r l; do
     n=$(field n "$l"); t=$(field ticks_per_s "$l"); f=$(field floor "$l")
     ratio=$(echo "$t $f" | awk '{ if ($1+0 > 0 && $2+0 > 0) printf "%.2f", $1 / $2; else print "-" }')
     rtf=$(echo "$t" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')
-    printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "${t:--}" "$rtf" \
+    printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "${t:--}" "$rtf" \
       "$(echo "$f" | awk '{ printf "%.0f", $1 }')" "$ratio" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
       "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field rss_agent_mb "$l")" "$(field pss_agent_mb "$l")" \
-      "$(up_cell "$l")" "$(field load "$l")" \
+      "$(up_cell "$l")" "$(field contacts "$l")" "$(field load "$l")" \
       "$(note_cell "$l")"
   done <"$OUT/lockstep.txt"
 fi
@@ -225,21 +227,21 @@ if ! skip realtime; then
   done
   echo
   echo "== real time: ${RT_TIME} s per N; criteria RTF >= 0.99, command age p99 <= 2 periods, missed < 0.1 % =="
-  echo "| N | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agents (each) | CPU discovery server | CPU probe | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | floor RTF (ticks/s / 50) | meets criteria | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| N | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agents (each) | CPU discovery server | CPU probe | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | floor RTF (ticks/s / 50) | meets criteria | drone contacts | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   best=0
   while read -r l; do
     n=$(field n "$l"); rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l"); mf=$(field missed_frac "$l")
     ok=$(echo "${rtf:-0} ${p99:-99} ${mf:-1}" | awk '{ print ($1 >= 0.99 && $2 <= 2 && $3 < 0.001) ? "yes" : "no" }')
     [ "$ok" = yes ] && [ "$n" -gt "$best" ] && best=$n
-    printf "| %s | %s | %s / %s / %s | %s (%s of %s) | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" \
+    printf "| %s | %s | %s / %s / %s | %s (%s of %s) | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" \
       "$n" "${rtf:--}" "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
       "$(missed_cell "$l")" \
       "$(field missed "$l")" "$(field drone_ticks "$l")" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
       "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field cpu_probe "$l")" "$(field rss_agent_mb "$l")" \
       "$(field pss_agent_mb "$l")" "$(up_cell "$l")" \
       "$(field floor "$l" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')" "$ok" \
-      "$(field load "$l")" "$(note_cell "$l")"
+      "$(field contacts "$l")" "$(field load "$l")" "$(note_cell "$l")"
   done <"$OUT/realtime.txt"
   echo "largest N meeting the real-time criteria: $best"
 fi
@@ -256,13 +258,13 @@ if ! skip hosts; then
   rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l")
   echo
   echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, ${RT_TIME} s =="
-  echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | host RSS (MB) | bring-up + discovery (s) | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|"
-  printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
+  echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | host RSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+  printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
     "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
     "$(missed_cell "$l")" \
     "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" "$(field cpu_agent_each "$l")" "$(field rss_agent_mb "$l")" \
-    "$(up_cell "$l")" "$(field load "$l")" \
+    "$(up_cell "$l")" "$(field contacts "$l")" "$(field load "$l")" \
     "$(note_cell "$l")"
 fi
 
