@@ -352,14 +352,14 @@ struct AgentApp::Impl {
       if (!b.fsm->addressed_to_me(c)) continue;
       if (joining && m.apply_tick() < s.tick()) {
         MissionAck a = b.fsm->resume(c, static_cast<double>(m.apply_tick()) * control_period_s, obs);
-        b.last_mission_seq = m.seq();
+        if (a.accepted) b.last_mission_seq = m.seq();
         w_ack.write(to_msg(a, m.issuer_instance()));
         spdlog::info("drone {}: joined mid-mission: caught up with {} seq {} of tick {}{}", id,
                      to_string(c.type), c.seq, m.apply_tick(), a.accepted ? "" : ": " + a.reason);
         continue;
       }
       MissionAck a = b.fsm->apply(c, obs);
-      b.last_mission_seq = m.seq();
+      if (a.accepted) b.last_mission_seq = m.seq();  // relayed by the server (SimStatus.mission_seq)
       w_ack.write(to_msg(a, m.issuer_instance()));
       spdlog::info("drone {}: {} seq {} {} at tick {}{}", id, to_string(c.type), c.seq,
                    a.accepted ? "accepted" : "rejected", s.tick(), a.accepted ? "" : ": " + a.reason);

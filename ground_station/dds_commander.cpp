@@ -185,14 +185,20 @@ struct DdsCommander::Impl {
     if (!w_mission.write(m)) return {false, "DDS refused the command"};
     lock.lock();
     const std::uint32_t s = c.seq;
+    // Accepted, as the server relays it from the agent's commands: for an
+    // agent whose ack writer this process never discovered.
+    auto relayed = [&](int id) {
+      return sim && id >= 0 && static_cast<std::size_t>(id) < sim->mission_seq().size() &&
+             sim->mission_seq()[static_cast<std::size_t>(id)] == s;
+    };
+    auto answered = [&](int id) { return acks[s].count(id) > 0 || relayed(id); };
     auto all_in = [&] {
       if (stop_requested()) return true;
-      const auto& got = acks[s];
       for (int id : expect)
-        if (!got.count(id)) return false;
+        if (!answered(id)) return false;
       if (c.target < 0)  // an agent heard only now must answer too
         for (int id : online_locked())
-          if (!got.count(id)) return false;
+          if (!answered(id)) return false;
       return true;
     };
     // One retry with the same seq after a third of the timeout: agents that
@@ -211,11 +217,16 @@ struct DdsCommander::Impl {
     }
     std::vector<int> missing;
     std::string rejected;
-    int accepted = 0;
+    int accepted = 0, via_server = 0;
     for (int id : expect) {
       auto it = got.find(id);
       if (it == got.end()) {
-        missing.push_back(id);
+        if (relayed(id)) {
+          ++accepted;
+          ++via_server;
+        } else {
+          missing.push_back(id);
+        }
       } else if (!it->second.accepted()) {
         rejected += fmt::format("{}rejected by {}: {}", rejected.empty() ? "" : "; ", id,
                                 it->second.reason().to_string());
@@ -226,6 +237,7 @@ struct DdsCommander::Impl {
     CommandResult r;
     r.ok = missing.empty() && rejected.empty();
     r.message = fmt::format("{} {}/{} acknowledged", to_string(c.type), accepted, expect.size());
+    if (via_server > 0) r.message += fmt::format(" ({} through the server)", via_server);
     if (!missing.empty()) r.message += fmt::format("; no ack from drones {}", fmt::join(missing, ", "));
     if (!rejected.empty()) r.message += "; " + rejected;
     if (c.type == MissionType::kTask) task_seq = s;

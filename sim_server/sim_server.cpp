@@ -76,6 +76,7 @@ struct Slot {
   std::uint64_t owner = 0;     // agent instance flying this drone, 0 = none
   bool live = false;
   double last_heard_wall = -1e9;
+  std::uint32_t mission_seq = 0;  // last mission command its agent accepted (relayed in SimStatus)
 };
 
 /// The part of a Slot that decides a drone's setpoint for one period.
@@ -122,9 +123,10 @@ struct SimServer::Impl {
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
-  // An agent came online or was lost since the last SimStatus. Set under mu;
-  // atomic so the per-tick check in publish_status needs no lock.
-  std::atomic<bool> live_changed{false};
+  // What a ground station waits for changed since the last SimStatus: an
+  // agent came online or was lost, or accepted a new mission command. Set
+  // under mu; atomic so the per-tick check in publish_status needs no lock.
+  std::atomic<bool> status_due{false};
   int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
   double agent_d_int = 0;
   // Random per process: Scene and SimStatus carry it, so agents and ground
@@ -263,6 +265,10 @@ struct SimServer::Impl {
     s.command_tick = c.tick();
     s.phase = static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
     s.busy = c.busy();
+    if (c.mission_seq() != s.mission_seq) {
+      s.mission_seq = c.mission_seq();
+      status_due = true;
+    }
     if (c.has_beacon() && c.own_beacon().drone_id() == c.drone_id() &&
         std::isfinite(c.own_beacon().position().x()) && std::isfinite(c.own_beacon().position().y()) &&
         std::isfinite(c.own_beacon().position().z())) {
@@ -305,7 +311,7 @@ struct SimServer::Impl {
       s.owner = instance;
       s.answered = false;
       ++unanswered;
-      live_changed = true;
+      status_due = true;
     }
     s.last_heard_wall = wall_seconds();
   }
@@ -346,7 +352,7 @@ struct SimServer::Impl {
         s.live = false;
         s.owner = 0;
         if (!s.answered) --unanswered;
-        live_changed = true;
+        status_due = true;
         counters.lockstep_timeouts(counters.lockstep_timeouts() + 1);
         spdlog::warn("drone {}: agent lost (silent for {:.1f} s); drone enters failsafe", i,
                      now - s.last_heard_wall);
@@ -637,8 +643,10 @@ struct SimServer::Impl {
     double now = wall_seconds();
     // Who is live goes out at once: a ground station that has just heard
     // every agent's heartbeat must not get a latched status listing none.
+    // So does a newly accepted mission command: it confirms the command to a
+    // ground station that never got that agent's ack.
     if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz &&
-        !live_changed.load(std::memory_order_relaxed))
+        !status_due.load(std::memory_order_relaxed))
       return;
     double dw = now - rtf_wall;
     if (dw >= 0.5) {
@@ -651,9 +659,12 @@ struct SimServer::Impl {
     {
       std::lock_guard<std::mutex> lock(mu);
       s = counters;
-      live_changed = false;
-      for (int i = 0; i < n; ++i)
+      status_due = false;
+      s.mission_seq().resize(static_cast<std::size_t>(n));
+      for (int i = 0; i < n; ++i) {
         if (slots[i].live) s.live_agents().push_back(static_cast<std::uint16_t>(i));
+        s.mission_seq()[static_cast<std::size_t>(i)] = slots[i].mission_seq;
+      }
       s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
     }
     s.rejected_malformed(static_cast<std::uint32_t>(malformed_samples().load()));
