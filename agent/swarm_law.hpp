@@ -152,7 +152,9 @@ bool swarm_condition(std::span<const Eigen::Vector3d> positions, double epsilon_
 /// diameter barely grows with n (about 1.75 D_int for 8 to 30 drones), so the
 /// default also holds for larger swarms. They get denser instead: from about
 /// 10 drones the closest settled pair is under 1 m apart, a limit of the
-/// summed linear law itself, not of epsilon.
+/// summed linear law itself, not of epsilon. With activation.neighbours the
+/// swarm spreads with n instead (about D_int between neighbours), and this
+/// default is too small past about 7 drones: set task.epsilon_m.
 using ddswarm::default_epsilon;
 
 }  // namespace ddswarm::agent
