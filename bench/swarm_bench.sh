@@ -271,12 +271,14 @@ fi
 # ---------------------------------------------------------------- plot
 if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   : >"$OUT/plot.dat"
-  # One row per N: plain, floor, pipelined (? where a variant was not run).
+  # One row per N: plain, floor, pipelined (? where a variant was not run, or
+  # its run failed: a swarm that never took off measures nothing).
   for n in $SIZES; do
     t="?"; p="?"; f="?"
     while read -r l; do
       [ "$(field n "$l")" = "$n" ] || continue
       f=$(field floor "$l")
+      [ -n "$(note_cell "$l")" ] && continue
       case "$(field variant "$l")" in plain) t=$(field ticks_per_s "$l") ;; pipelined) p=$(field ticks_per_s "$l") ;; esac
     done <"$OUT/lockstep.txt"
     echo "$n ${t:-?} ${f:-?} ${p:-?}" | sed 's/nan/?/g' |
@@ -285,6 +287,7 @@ if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   : >"$OUT/plot_rt.dat"
   [ -f "$OUT/realtime.txt" ] && while read -r l; do
     r=$(field rtf "$l")
+    [ -n "$(note_cell "$l")" ] && r="?"
     echo "$(field n "$l") ${r:-?}" >>"$OUT/plot_rt.dat"
   done <"$OUT/realtime.txt"
   gnuplot <<EOF
@@ -298,7 +301,7 @@ set datafile missing "?"
 set xtics (6, 10, 16, 32, 64, 128)
 set xrange [4:180]
 set grid
-set key top right box opaque
+set key bottom left box opaque
 plot "$OUT/plot.dat" using 1:3 with linespoints lw 2 title "bare Fast DDS floor (ticks/s / 50)", \
      "$OUT/plot.dat" using 1:2 with linespoints lw 2 title "ddswarm lockstep (ticks/s / 50)", \
      "$OUT/plot.dat" using 1:4 with linespoints lw 2 title "ddswarm lockstep, pipelined (ticks/s / 50)", \
