@@ -456,12 +456,6 @@ struct AgentApp::Impl {
     // swarm missed the server, its agents must not all re-join at once.
     const double patience =
         cfg.agent.rejoin_after_s * (1.0 + 0.5 * static_cast<double>(brains[0]->instance % 1024) / 1024.0);
-    // Discovery can also fail one way: the server reads our commands, yet we
-    // never hear it (seen at 128 processes: an agent online at the server for
-    // 14 s without a scene). Once our command writer has a reader, the scene
-    // should follow within moments; after a quarter of the patience, re-join.
-    const double one_sided_patience = patience / 4;
-    double read_since = -1;  // wall time our command writer first had a reader
     double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
@@ -480,17 +474,9 @@ struct AgentApp::Impl {
         // Fast DDS 2.9 sometimes never matches one of 128 participants that
         // start at once (docs/performance.md); a new participant is
         // discovered afresh. No scene also means no mission to lose.
-        const double now = wall_seconds();
-        if (!scene && read_since < 0 && w_cmd.matched() > 0) read_since = now;
-        if (!scene && cfg.agent.rejoin_after_s > 0 && now - joined > patience) {
+        if (!scene && cfg.agent.rejoin_after_s > 0 && wall_seconds() - joined > patience) {
           spdlog::warn("{}: no scene within {:.1f} s; leaving DDS and joining again as a new participant",
                        label, patience);
-          return AgentApp::End::kNoScene;
-        }
-        if (!scene && cfg.agent.rejoin_after_s > 0 && read_since >= 0 && now - read_since > one_sided_patience) {
-          spdlog::warn("{}: the server has read our commands for {:.1f} s but no scene came (one-way "
-                       "discovery); leaving DDS and joining again as a new participant",
-                       label, now - read_since);
           return AgentApp::End::kNoScene;
         }
       }
