@@ -59,6 +59,7 @@ struct DdsCommander::Impl {
   std::uint32_t seq = 0;
   std::uint32_t task_seq = 0;
   double last_command_wall = -1e9;  // when the latest command was sent
+  std::uint32_t last_seq = 0;       // the latest command's seq
   Reader<msg::MissionAck>* ack_reader = nullptr;
   Reader<msg::TaskStatus>* task_reader = nullptr;
   std::optional<TaskOutcome> outcome;
@@ -181,6 +182,7 @@ struct DdsCommander::Impl {
     // transient-local history must not replay an old mission in a new world).
     if (sim) m.server_instance(sim->server_instance());
     last_command_wall = wall_seconds();
+    last_seq = c.seq;
     lock.unlock();
     if (!w_mission.write(m)) return {false, "DDS refused the command"};
     lock.lock();
@@ -293,12 +295,22 @@ bool DdsCommander::wait_airborne(int count, double timeout_s) {
 bool DdsCommander::wait_takeoff_done(int count, double timeout_s) {
   return impl_->wait(timeout_s, [&] {
     if (!impl_->sim || impl_->sim->airborne() < count) return false;
-    // Only a heartbeat sent after the command tells the agent's phase now: in
-    // lockstep a whole climb can pass between two heartbeats.
+    auto climbing = [](Phase p) { return p == Phase::kTakeoff || p == Phase::kIdle; };
+    const auto& sim = *impl_->sim;
     for (int id : impl_->online_locked()) {
+      // Only a heartbeat sent after the command tells the agent's phase now: in
+      // lockstep a whole climb can pass between two heartbeats.
       auto it = impl_->agents.find(id);
-      if (it == impl_->agents.end() || it->second.wall <= impl_->last_command_wall) return false;
-      if (it->second.phase == Phase::kTakeoff || it->second.phase == Phase::kIdle) return false;
+      if (it != impl_->agents.end() && it->second.wall > impl_->last_command_wall) {
+        if (climbing(it->second.phase)) return false;
+        continue;
+      }
+      // Or the server's word, for an agent whose heartbeats never reach us:
+      // it has accepted the command and reports a phase past the climb.
+      const auto k = static_cast<std::size_t>(id);
+      if (k >= sim.mission_seq().size() || k >= sim.phase().size() ||
+          sim.mission_seq()[k] != impl_->last_seq || climbing(static_cast<Phase>(sim.phase()[k])))
+        return false;
     }
     return true;
   });

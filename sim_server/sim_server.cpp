@@ -263,12 +263,13 @@ struct SimServer::Impl {
     s.setpoint.motors_on = c.motors_on();
     s.has_command = true;
     s.command_tick = c.tick();
-    s.phase = static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
-    s.busy = c.busy();
-    if (c.mission_seq() != s.mission_seq) {
+    const Phase phase = static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
+    if (c.mission_seq() != s.mission_seq || phase != s.phase) {
       s.mission_seq = c.mission_seq();
       status_due = true;
     }
+    s.phase = phase;
+    s.busy = c.busy();
     if (c.has_beacon() && c.own_beacon().drone_id() == c.drone_id() &&
         std::isfinite(c.own_beacon().position().x()) && std::isfinite(c.own_beacon().position().y()) &&
         std::isfinite(c.own_beacon().position().z())) {
@@ -643,8 +644,9 @@ struct SimServer::Impl {
     double now = wall_seconds();
     // Who is live goes out at once: a ground station that has just heard
     // every agent's heartbeat must not get a latched status listing none.
-    // So does a newly accepted mission command: it confirms the command to a
-    // ground station that never got that agent's ack.
+    // So does a newly accepted mission command or a new phase: they confirm
+    // the command, and its progress, to a ground station that never got that
+    // agent's ack or heartbeats.
     if (!force && now - last_status_wall < 1.0 / cfg.sim.status_rate_hz &&
         !status_due.load(std::memory_order_relaxed))
       return;
@@ -661,9 +663,12 @@ struct SimServer::Impl {
       s = counters;
       status_due = false;
       s.mission_seq().resize(static_cast<std::size_t>(n));
+      s.phase().resize(static_cast<std::size_t>(n));
       for (int i = 0; i < n; ++i) {
+        const auto k = static_cast<std::size_t>(i);
         if (slots[i].live) s.live_agents().push_back(static_cast<std::uint16_t>(i));
-        s.mission_seq()[static_cast<std::size_t>(i)] = slots[i].mission_seq;
+        s.mission_seq()[k] = slots[i].mission_seq;
+        s.phase()[k] = static_cast<std::uint8_t>(slots[i].phase);
       }
       s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
     }
