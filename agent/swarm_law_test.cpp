@@ -167,26 +167,29 @@ struct Packing {
   bool connected = false;      ///< every drone within 1.5 D_int of the rest, transitively
 };
 
+/// One kinematic step of every drone on the law alone: x += v dt.
+void step_swarm(std::vector<Vector3d>& p, const AgentConfig& c, double dt) {
+  std::vector<Vector3d> peers, v(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    peers.clear();
+    for (std::size_t j = 0; j < p.size(); ++j)
+      if (j != i) peers.push_back(p[j]);
+    LawInput in;
+    in.p_world = p[i];
+    in.peers_world = peers;
+    v[i] = control_velocity(in, c);
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) p[i] += dt * v[i];
+}
+
 /// Flies n drones from a square start grid (spacing m apart, one altitude) on
-/// the swarm term alone, kinematically (x += v dt, 20 Hz), for t_s seconds.
+/// the swarm term alone, kinematically (20 Hz), for t_s seconds.
 Packing settle(int n, double spacing, const AgentConfig& c, double t_s) {
   std::vector<Vector3d> p;
   const int side = static_cast<int>(std::ceil(std::sqrt(n)));
   for (int i = 0; i < n; ++i) p.emplace_back(spacing * (i % side), spacing * (i / side), 2.0);
   const double dt = 0.05;
-  std::vector<Vector3d> peers, v(p.size());
-  for (int step = 0; step < static_cast<int>(t_s / dt); ++step) {
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      peers.clear();
-      for (std::size_t j = 0; j < p.size(); ++j)
-        if (j != i) peers.push_back(p[j]);
-      LawInput in;
-      in.p_world = p[i];
-      in.peers_world = peers;
-      v[i] = control_velocity(in, c);
-    }
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] += dt * v[i];
-  }
+  for (int step = 0; step < static_cast<int>(t_s / dt); ++step) step_swarm(p, c, dt);
   Packing k;
   std::vector<int> comp(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) comp[i] = static_cast<int>(i);
@@ -434,34 +437,14 @@ TEST(SwarmCondition, SixScatteredDronesGatherWithinDefaultEpsilonWithoutCrowding
   const double dt = 0.05;
   double t_swarmed = -1;
   for (int step = 0; step < 4000 && t_swarmed < 0; ++step) {
-    std::vector<Vector3d> v(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      std::vector<Vector3d> peers;
-      for (std::size_t j = 0; j < p.size(); ++j)
-        if (j != i) peers.push_back(p[j]);
-      LawInput in;
-      in.p_world = p[i];
-      in.peers_world = peers;
-      v[i] = control_velocity(in, c);
-    }
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] += dt * v[i];
+    step_swarm(p, c, dt);
     if (swarm_condition(p, eps)) t_swarmed = step * dt;
   }
   ASSERT_GT(t_swarmed, 0) << "never gathered";
   EXPECT_LT(t_swarmed, 60.0);
   // Let it settle, then check the equilibrium the default epsilon was chosen from.
   for (int step = 0; step < 4000; ++step) {
-    std::vector<Vector3d> v(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      std::vector<Vector3d> peers;
-      for (std::size_t j = 0; j < p.size(); ++j)
-        if (j != i) peers.push_back(p[j]);
-      LawInput in;
-      in.p_world = p[i];
-      in.peers_world = peers;
-      v[i] = control_velocity(in, c);
-    }
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] += dt * v[i];
+    step_swarm(p, c, dt);
   }
   double dmin = 1e9, dmax = 0;
   for (std::size_t i = 0; i < p.size(); ++i)
