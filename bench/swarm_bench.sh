@@ -301,7 +301,8 @@ set datafile missing "?"
 set xtics (6, 10, 16, 32, 64, 128)
 set xrange [4:180]
 set grid
-set key bottom left box opaque
+set key bottom right box opaque
+set yrange [0.03:150]
 plot "$OUT/plot.dat" using 1:3 with linespoints lw 2 title "bare Fast DDS floor (ticks/s / 50)", \
      "$OUT/plot.dat" using 1:2 with linespoints lw 2 title "ddswarm lockstep (ticks/s / 50)", \
      "$OUT/plot.dat" using 1:4 with linespoints lw 2 title "ddswarm lockstep, pipelined (ticks/s / 50)", \
