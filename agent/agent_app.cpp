@@ -86,7 +86,8 @@ struct DroneBrain {
   // (issuer, seq) -> the apply_tick it came with; oldest first for pruning.
   std::map<std::pair<std::uint64_t, std::uint32_t>, std::uint64_t> seen_missions;
   std::deque<std::pair<std::uint64_t, std::uint32_t>> seen_order;
-  std::uint32_t last_mission_seq = 0;
+  std::uint32_t last_mission_seq = 0;      // the last mission command accepted: its seq
+  std::uint64_t last_mission_issuer = 0;   // and its issuer_instance
   bool caught_up = false;  // the mission in force (the ring) was taken from the first sample
   std::uint64_t rejected = 0, sent = 0;
   std::uint64_t rival = 0;  // another instance heard on this id during the start-up probe
@@ -97,6 +98,12 @@ struct DroneBrain {
   std::vector<std::uint8_t> hits;
 
   explicit DroneBrain(int drone_id) : id(drone_id) {}
+
+  /// Remembers m as the last command accepted; every VelocityCommand reports it.
+  void accepted(const msg::MissionCommand& m) {
+    last_mission_seq = m.seq();
+    last_mission_issuer = m.issuer_instance();
+  }
 
   void reset_mission() {
     fsm.reset();
@@ -352,14 +359,14 @@ struct AgentApp::Impl {
       if (!b.fsm->addressed_to_me(c)) continue;
       if (joining && m.apply_tick() < s.tick()) {
         MissionAck a = b.fsm->resume(c, static_cast<double>(m.apply_tick()) * control_period_s, obs);
-        if (a.accepted) b.last_mission_seq = m.seq();
+        if (a.accepted) b.accepted(m);
         w_ack.write(to_msg(a, m.issuer_instance()));
         spdlog::info("drone {}: joined mid-mission: caught up with {} seq {} of tick {}{}", id,
                      to_string(c.type), c.seq, m.apply_tick(), a.accepted ? "" : ": " + a.reason);
         continue;
       }
       MissionAck a = b.fsm->apply(c, obs);
-      if (a.accepted) b.last_mission_seq = m.seq();  // relayed by the server (SimStatus.mission_seq)
+      if (a.accepted) b.accepted(m);  // relayed by the server (SimStatus.mission_seq, mission_issuer)
       w_ack.write(to_msg(a, m.issuer_instance()));
       spdlog::info("drone {}: {} seq {} {} at tick {}{}", id, to_string(c.type), c.seq,
                    a.accepted ? "accepted" : "rejected", s.tick(), a.accepted ? "" : ": " + a.reason);
@@ -434,6 +441,7 @@ struct AgentApp::Impl {
     cmd.phase(static_cast<std::uint8_t>(out.phase));
     cmd.busy(out.busy);
     cmd.mission_seq(b.last_mission_seq);
+    cmd.mission_issuer(b.last_mission_issuer);
     cmd.agent_instance(b.instance);
     if (b.modelled && cfg.comm.source == PeerSourceType::kBeacons && b.modelled->beacon_due(s.tick())) {
       PeerMessage pm = b.modelled->beacon(s.tick(), s.sim_time_s(), obs.p_world);

@@ -155,6 +155,14 @@ struct DdsCommander::Impl {
   }
 
   /// The server hears our commands and every online agent's acks reach us. mu held.
+  /// The server says drone id's agent accepted our command seq (relayed from
+  /// its VelocityCommand): for an agent whose acks or heartbeats never reach us.
+  bool accepted_by(int id, std::uint32_t seq) const {
+    const auto k = static_cast<std::size_t>(id);
+    return sim && id >= 0 && k < sim->mission_seq().size() && k < sim->mission_issuer().size() &&
+           sim->mission_seq()[k] == seq && sim->mission_issuer()[k] == instance;
+  }
+
   bool all_matched() const {
     // One ack writer per agent process; an agent host flies many drones.
     std::set<std::string> processes;
@@ -189,10 +197,7 @@ struct DdsCommander::Impl {
     const std::uint32_t s = c.seq;
     // Accepted, as the server relays it from the agent's commands: for an
     // agent whose ack writer this process never discovered.
-    auto relayed = [&](int id) {
-      return sim && id >= 0 && static_cast<std::size_t>(id) < sim->mission_seq().size() &&
-             sim->mission_seq()[static_cast<std::size_t>(id)] == s;
-    };
+    auto relayed = [&](int id) { return accepted_by(id, s); };
     auto answered = [&](int id) { return acks[s].count(id) > 0 || relayed(id); };
     auto all_in = [&] {
       if (stop_requested()) return true;
@@ -308,8 +313,8 @@ bool DdsCommander::wait_takeoff_done(int count, double timeout_s) {
       // Or the server's word, for an agent whose heartbeats never reach us:
       // it has accepted the command and reports a phase past the climb.
       const auto k = static_cast<std::size_t>(id);
-      if (k >= sim.mission_seq().size() || k >= sim.phase().size() ||
-          sim.mission_seq()[k] != impl_->last_seq || climbing(static_cast<Phase>(sim.phase()[k])))
+      if (!impl_->accepted_by(id, impl_->last_seq) || k >= sim.phase().size() ||
+          climbing(static_cast<Phase>(sim.phase()[k])))
         return false;
     }
     return true;

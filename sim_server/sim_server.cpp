@@ -76,7 +76,8 @@ struct Slot {
   std::uint64_t owner = 0;     // agent instance flying this drone, 0 = none
   bool live = false;
   double last_heard_wall = -1e9;
-  std::uint32_t mission_seq = 0;  // last mission command its agent accepted (relayed in SimStatus)
+  std::uint32_t mission_seq = 0;     // last mission command its agent accepted (relayed in SimStatus)
+  std::uint64_t mission_issuer = 0;  // and its issuer
 };
 
 /// The part of a Slot that decides a drone's setpoint for one period.
@@ -124,7 +125,8 @@ struct SimServer::Impl {
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   // What a ground station waits for changed since the last SimStatus: an
-  // agent came online or was lost, or accepted a new mission command. Set
+  // agent came online or was lost, accepted a new mission command, or changed
+  // phase. Set
   // under mu; atomic so the per-tick check in publish_status needs no lock.
   std::atomic<bool> status_due{false};
   int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
@@ -264,8 +266,9 @@ struct SimServer::Impl {
     s.has_command = true;
     s.command_tick = c.tick();
     const Phase phase = static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
-    if (c.mission_seq() != s.mission_seq || phase != s.phase) {
+    if (c.mission_seq() != s.mission_seq || c.mission_issuer() != s.mission_issuer || phase != s.phase) {
       s.mission_seq = c.mission_seq();
+      s.mission_issuer = c.mission_issuer();
       status_due = true;
     }
     s.phase = phase;
@@ -663,11 +666,13 @@ struct SimServer::Impl {
       s = counters;
       status_due = false;
       s.mission_seq().resize(static_cast<std::size_t>(n));
+      s.mission_issuer().resize(static_cast<std::size_t>(n));
       s.phase().resize(static_cast<std::size_t>(n));
       for (int i = 0; i < n; ++i) {
         const auto k = static_cast<std::size_t>(i);
         if (slots[i].live) s.live_agents().push_back(static_cast<std::uint16_t>(i));
         s.mission_seq()[k] = slots[i].mission_seq;
+        s.mission_issuer()[k] = slots[i].mission_issuer;
         s.phase()[k] = static_cast<std::uint8_t>(slots[i].phase);
       }
       s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
