@@ -24,6 +24,7 @@
 #   --plot FILE.png    real-time factor against N (gnuplot)
 #   --set KEY=VALUE    scenario override for every swarm (ddswarm-launch --set), repeatable,
 #                      e.g. --set sim.physics_rate_hz=500
+#   --dds-profiles F   QoS profiles XML for every swarm process, the probe and the ground station
 #   --quick            a smoke run: N = 4 and 8, a few seconds each, 1 run per Table 1 set
 # Every process is started here or by ddswarm-launch and stopped by PID; every
 # run is bounded in time.
@@ -40,6 +41,7 @@ SKIP=""
 T1_RUNS=15
 PLOT=""
 SETS=()
+PROFILE_ARGS=()   # --dds-profiles for the tools this script starts itself
 HOSTS_N=512
 HOSTS_K=2
 HOSTS_PHYS=250
@@ -59,6 +61,7 @@ while [ $# -gt 0 ]; do
     --table1-runs) T1_RUNS="$2"; shift 2 ;;
     --plot) PLOT="$2"; shift 2 ;;
     --set) SETS+=(--set "$2"); shift 2 ;;
+    --dds-profiles) SETS+=(--set "dds.profiles_file=$(realpath "$2")"); PROFILE_ARGS=(--dds-profiles "$(realpath "$2")"); shift 2 ;;
     --hosts-drones) HOSTS_N="$2"; shift 2 ;;
     --agent-hosts) HOSTS_K="$2"; shift 2 ;;
     --hosts-physics) HOSTS_PHYS="$2"; shift 2 ;;
@@ -66,7 +69,7 @@ while [ $# -gt 0 ]; do
     --table1-jobs) T1_JOBS="$2"; shift 2 ;;
     --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; HOSTS_N=16; shift ;;
     --lockstep) LS_VARIANTS="$2"; shift 2 ;;
-    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,31p' "$0"; exit 0 ;;
     *) echo "swarm_bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -141,14 +144,14 @@ run_swarm() {
   done
   local addr; addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$log/launch.err")
   [ -n "$addr" ] && ds=(--discovery-server "$addr")
-  local gs=("$BIN/ddswarm-gs" --config "$scenario" --domain "$dom" "${ds[@]}")
+  local gs=("$BIN/ddswarm-gs" --config "$scenario" --domain "$dom" "${ds[@]}" "${PROFILE_ARGS[@]}")
   local up="nan" why=""
   if timeout 200 "${gs[@]}" wait-agents --count "$n" --timeout 180 >"$log/gs-wait.log" 2>&1; then
     up=$(echo "$(date +%s.%N) - $t0" | bc)
   else
     why="agents not online: $(tail -1 "$log/gs-wait.log")"
   fi
-  local probe_args=(--drones "$n" --launcher-pid "$LAUNCH_PID" --domain "$dom" "${ds[@]}" --time "$secs"
+  local probe_args=(--drones "$n" --launcher-pid "$LAUNCH_PID" --domain "$dom" "${ds[@]}" "${PROFILE_ARGS[@]}" --time "$secs"
                     --settle 3 --timeout 240)
   [ "$mode" = realtime ] && probe_args+=(--ages)
   local line=""

@@ -46,6 +46,7 @@ void load(YamlSection s, DdsConfig& c) {
   s.get("participant_id", c.participant_id);
   s.get("lease_duration_s", c.lease_duration_s);
   s.get("profiles_file", c.profiles_file);
+  s.get("best_effort_streams", c.best_effort_streams);
   s.finish();
 }
 

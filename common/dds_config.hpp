@@ -41,6 +41,12 @@ struct DdsConfig {
                                       ///< (at most max_participant_id(domain_id): the RTPS ports must fit)
   double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement
   std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles
+  /// Real time only: the per-tick streams (swarm state out, velocity commands
+  /// back; profiles `state` and `command`) go best-effort, as a newer sample
+  /// supersedes a lost one. Every process of the swarm must agree (they read
+  /// it from the same scenario): a reliable reader never matches a
+  /// best-effort writer. The server refuses it in lockstep.
+  bool best_effort_streams = false;
   /// --secure: a directory made by scripts/make-certs; empty = DDS Security off
   /// (docs/security.md). With it, the participant authenticates (PKI-DH), is
   /// access controlled (signed governance and permissions) and encrypts (AES-GCM).

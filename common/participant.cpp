@@ -144,6 +144,7 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   load_profiles_once(cfg.profiles_file);
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   secure_ = cfg.secure();
+  best_effort_streams_ = cfg.best_effort_streams;
   role_ = cfg.security_role;
   participant_ = factory->create_participant(cfg.domain_id, make_qos(cfg, name));
   if (!participant_)

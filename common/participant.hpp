@@ -20,6 +20,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "common/dds_config.hpp"
 #include "common/topics.hpp"
@@ -102,7 +103,16 @@ class Participant {
   template <class T>
   Writer<T> writer(const std::string& partition = "") {
     auto* topic = topic_for<T>();
-    auto* w = publisher_for(partition)->create_datawriter_with_profile(topic, Topic<T>::profile);
+    auto* pub = publisher_for(partition);
+    fdds::DataWriter* w = nullptr;
+    if (best_effort(Topic<T>::profile)) {
+      fdds::DataWriterQos q;
+      pub->get_datawriter_qos_from_profile(Topic<T>::profile, q);
+      q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+      w = pub->create_datawriter(topic, q);
+    } else {
+      w = pub->create_datawriter_with_profile(topic, Topic<T>::profile);
+    }
     if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name + refused_hint(partition));
     return Writer<T>(w);
   }
@@ -115,7 +125,16 @@ class Participant {
     const std::string partition = partition_opt.value_or(secure_ && kPerDronePartition<T> ? "drone/*" : "");
     auto* topic = topic_for<T>();
     auto listener = std::make_unique<Reader<T>>(std::move(handler));
-    auto* r = subscriber_for(partition)->create_datareader_with_profile(topic, Topic<T>::profile, listener.get());
+    auto* sub = subscriber_for(partition);
+    fdds::DataReader* r = nullptr;
+    if (best_effort(Topic<T>::profile)) {
+      fdds::DataReaderQos q;
+      sub->get_datareader_qos_from_profile(Topic<T>::profile, q);
+      q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+      r = sub->create_datareader(topic, q, listener.get());
+    } else {
+      r = sub->create_datareader_with_profile(topic, Topic<T>::profile, listener.get());
+    }
     if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));
     listener->attach(r);
     auto& ref = *listener;
@@ -142,6 +161,10 @@ class Participant {
   fdds::Subscriber* subscriber_for(const std::string& partition);
   /// Under DDS Security, why creating an endpoint may fail; empty otherwise.
   std::string refused_hint(const std::string& partition) const;
+  /// dds.best_effort_streams: the per-tick streams' profiles lose RELIABLE.
+  bool best_effort(std::string_view profile) const {
+    return best_effort_streams_ && (profile == "state" || profile == "command");
+  }
 
   template <class T>
   fdds::Topic* topic_for() {
@@ -161,6 +184,7 @@ class Participant {
   fdds::DomainParticipant* participant_ = nullptr;
   bool closed_ = false;
   bool secure_ = false;
+  bool best_effort_streams_ = false;
   std::string role_;
   fdds::Publisher* publisher_ = nullptr;
   fdds::Subscriber* subscriber_ = nullptr;

@@ -37,6 +37,9 @@ void ServerConfig::validate() const {
                      "must be <= the world's size (diagonal of scene.bounds_min..bounds_max, " +
                          to_text(world_m) + " m)");
   dds.validate();
+  if (dds.best_effort_streams && scenario.mode == TimeMode::kLockstep)
+    throw FieldError("dds.best_effort_streams", "true",
+                     "needs scenario.mode: realtime (a lockstep tick waits for every state and command)");
   (void)scene.start_positions(scenario.drones, scenario.seed);
 }
 
