@@ -14,6 +14,10 @@
 #                      step right after its state) and pipelined (sim.lockstep_pipeline:
 #                      physics runs while agents answer; commands act one tick later)
 #   --rt-time S        real-time seconds measured per N (default 60)
+#   --rt-streams best-effort|reliable   real time: the state and command streams' QoS
+#                      (dds.best_effort_streams; default best-effort)
+#   --rt-grace G       real time: sim.realtime_grace, the share of a period the server waits
+#                      for late answers (default 0.6; the shipped default is 0.25)
 #   --floor-time S     floor seconds measured per N (default 5)
 #   --skip floor,lockstep,realtime,hosts,table1   parts to leave out
 #   --hosts-drones N   agent-host part: N drones of config/swarm_field.yaml in real time,
@@ -25,6 +29,7 @@
 #   --set KEY=VALUE    scenario override for every swarm (ddswarm-launch --set), repeatable,
 #                      e.g. --set sim.physics_rate_hz=500
 #   --dds-profiles F   QoS profiles XML for every swarm process, the probe and the ground station
+#   --best-effort-streams   real time: state and commands best-effort (dds.best_effort_streams)
 #   --quick            a smoke run: N = 4 and 8, a few seconds each, 1 run per Table 1 set
 # Every process is started here or by ddswarm-launch and stopped by PID; every
 # run is bounded in time.
@@ -41,13 +46,15 @@ SKIP=""
 T1_RUNS=15
 PLOT=""
 SETS=()
-PROFILE_ARGS=()   # --dds-profiles for the tools this script starts itself
+PROFILE_ARGS=()   # DDS options for the tools this script starts itself (probe, ground station)
 HOSTS_N=512
 HOSTS_K=2
 HOSTS_PHYS=250
 HOSTS_SENS=10
 T1_JOBS=2
 LS_VARIANTS="plain pipelined"
+RT_STREAMS=best-effort
+RT_GRACE=0.6
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) BIN="$2"; shift 2 ;;
@@ -61,7 +68,8 @@ while [ $# -gt 0 ]; do
     --table1-runs) T1_RUNS="$2"; shift 2 ;;
     --plot) PLOT="$2"; shift 2 ;;
     --set) SETS+=(--set "$2"); shift 2 ;;
-    --dds-profiles) SETS+=(--set "dds.profiles_file=$(realpath "$2")"); PROFILE_ARGS=(--dds-profiles "$(realpath "$2")"); shift 2 ;;
+    --dds-profiles) SETS+=(--set "dds.profiles_file=$(realpath "$2")"); PROFILE_ARGS+=(--dds-profiles "$(realpath "$2")"); shift 2 ;;
+    --best-effort-streams) SETS+=(--set dds.best_effort_streams=true); PROFILE_ARGS+=(--best-effort-streams); shift ;;
     --hosts-drones) HOSTS_N="$2"; shift 2 ;;
     --agent-hosts) HOSTS_K="$2"; shift 2 ;;
     --hosts-physics) HOSTS_PHYS="$2"; shift 2 ;;
@@ -69,7 +77,9 @@ while [ $# -gt 0 ]; do
     --table1-jobs) T1_JOBS="$2"; shift 2 ;;
     --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; HOSTS_N=16; shift ;;
     --lockstep) LS_VARIANTS="$2"; shift 2 ;;
-    -h|--help) sed -n '2,31p' "$0"; exit 0 ;;
+    --rt-streams) RT_STREAMS="$2"; shift 2 ;;
+    --rt-grace) RT_GRACE="$2"; shift 2 ;;
+    -h|--help) sed -n '2,/^set -u/{/^#/p}' "$0"; exit 0 ;;
     *) echo "swarm_bench: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -127,6 +137,7 @@ EOF
 RUN_SCENARIO=""   # run_swarm's scenario (default: $SCENARIO)
 RUN_EXTRA=()      # run_swarm's extra ddswarm-launch arguments
 RUN_TAG=""        # run_swarm's log directory suffix
+RUN_TOOL_ARGS=()  # run_swarm's extra DDS options for the probe and the ground station
 run_swarm() {
   local mode="$1" n="$2" secs="$3"
   local scenario="${RUN_SCENARIO:-$SCENARIO}"
@@ -144,14 +155,14 @@ run_swarm() {
   done
   local addr; addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$log/launch.err")
   [ -n "$addr" ] && ds=(--discovery-server "$addr")
-  local gs=("$BIN/ddswarm-gs" --config "$scenario" --domain "$dom" "${ds[@]}" "${PROFILE_ARGS[@]}")
+  local gs=("$BIN/ddswarm-gs" --config "$scenario" --domain "$dom" "${ds[@]}" "${PROFILE_ARGS[@]}" "${RUN_TOOL_ARGS[@]}")
   local up="nan" why=""
   if timeout 200 "${gs[@]}" wait-agents --count "$n" --timeout 180 >"$log/gs-wait.log" 2>&1; then
     up=$(echo "$(date +%s.%N) - $t0" | bc)
   else
     why="agents not online: $(tail -1 "$log/gs-wait.log")"
   fi
-  local probe_args=(--drones "$n" --launcher-pid "$LAUNCH_PID" --domain "$dom" "${ds[@]}" "${PROFILE_ARGS[@]}" --time "$secs"
+  local probe_args=(--drones "$n" --launcher-pid "$LAUNCH_PID" --domain "$dom" "${ds[@]}" "${PROFILE_ARGS[@]}" "${RUN_TOOL_ARGS[@]}" --time "$secs"
                     --settle 3 --timeout 240)
   [ "$mode" = realtime ] && probe_args+=(--ages)
   local line=""
@@ -224,12 +235,19 @@ fi
 # ---------------------------------------------------------------- real time
 if ! skip realtime; then
   : >"$OUT/realtime.txt"
+  case "$RT_STREAMS" in
+    best-effort) RUN_EXTRA=(--set dds.best_effort_streams=true); RUN_TOOL_ARGS=(--best-effort-streams) ;;
+    reliable) RUN_EXTRA=(); RUN_TOOL_ARGS=() ;;
+    *) echo "swarm_bench: --rt-streams must be best-effort or reliable, not '$RT_STREAMS'" >&2; exit 2 ;;
+  esac
+  RUN_EXTRA+=(--set "sim.realtime_grace=$RT_GRACE")
   for n in $RT_SIZES; do
     echo "swarm_bench: real time N=$n, ${RT_TIME} s (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
     echo "$(run_swarm realtime "$n" "$RT_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/realtime.txt"
   done
+  RUN_EXTRA=(); RUN_TOOL_ARGS=()
   echo
-  echo "== real time: ${RT_TIME} s per N; criteria RTF >= 0.99, command age p99 <= 2 periods, missed < 0.1 % =="
+  echo "== real time: ${RT_TIME} s per N, $RT_STREAMS state and commands, realtime_grace $RT_GRACE; criteria RTF >= 0.99, command age p99 <= 2 periods, missed < 0.1 % =="
   echo "| N | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agents (each) | CPU discovery server | CPU probe | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | floor RTF (ticks/s / 50) | meets criteria | drone contacts | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   best=0

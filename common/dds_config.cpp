@@ -152,6 +152,10 @@ void add_dds_options(CLI::App& app, DdsConfig& c) {
       ->group("Networking (default: this machine only)");
   app.add_option("--participant-id", c.participant_id, "RTPS participant id (-1 automatic)")
       ->group("Networking (default: this machine only)");
+  app.add_flag("--best-effort-streams", c.best_effort_streams,
+               "real time: swarm state and velocity commands best-effort (dds.best_effort_streams; "
+               "every process of the swarm must agree)")
+      ->group("Networking (default: this machine only)");
   app.add_option("--secure", c.security_dir,
                  "DDS Security: authenticate, access-control and encrypt with the credentials in DIR "
                  "(made by scripts/make-certs)")
@@ -176,6 +180,7 @@ void merge_cli(DdsConfig& target, const DdsConfig& cli, const CLI::App& app) {
   if (app.count("--dds-interface") || app.count("--dds-local-ip")) target.interface_ip = cli.interface_ip;
   if (app.count("--dds-profiles")) target.profiles_file = cli.profiles_file;
   if (app.count("--participant-id")) target.participant_id = cli.participant_id;
+  if (app.count("--best-effort-streams")) target.best_effort_streams = cli.best_effort_streams;
   if (app.count("--secure")) target.security_dir = cli.security_dir;
   if (app.count("--security-role")) target.security_role = cli.security_role;
 }

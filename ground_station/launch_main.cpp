@@ -175,6 +175,7 @@ int main(int argc, char** argv) {
         dds_args.push_back(v);
       }
     }
+    if (app.count("--best-effort-streams")) dds_args.push_back("--best-effort-streams");
     const std::string bin = Launcher::self_dir();
     install_stop_signals();
     const bool stop_on_death = on_death == "stop";
