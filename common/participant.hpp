@@ -106,10 +106,11 @@ class Participant {
     auto* pub = publisher_for(partition);
     fdds::DataWriter* w = nullptr;
     if (best_effort(Topic<T>::profile)) {
-      fdds::DataWriterQos q;
-      pub->get_datawriter_qos_from_profile(Topic<T>::profile, q);
-      q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
-      w = pub->create_datawriter(topic, q);
+      fdds::DataWriterQos q;  // a missing profile fails as create_datawriter_with_profile would
+      if (pub->get_datawriter_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
+        q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+        w = pub->create_datawriter(topic, q);
+      }
     } else {
       w = pub->create_datawriter_with_profile(topic, Topic<T>::profile);
     }
@@ -129,9 +130,10 @@ class Participant {
     fdds::DataReader* r = nullptr;
     if (best_effort(Topic<T>::profile)) {
       fdds::DataReaderQos q;
-      sub->get_datareader_qos_from_profile(Topic<T>::profile, q);
-      q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
-      r = sub->create_datareader(topic, q, listener.get());
+      if (sub->get_datareader_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
+        q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+        r = sub->create_datareader(topic, q, listener.get());
+      }
     } else {
       r = sub->create_datareader_with_profile(topic, Topic<T>::profile, listener.get());
     }
