@@ -20,7 +20,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <string_view>
 
 #include "common/dds_config.hpp"
 #include "common/topics.hpp"
@@ -105,14 +104,10 @@ class Participant {
     auto* topic = topic_for<T>();
     auto* pub = publisher_for(partition);
     fdds::DataWriter* w = nullptr;
-    if (best_effort(Topic<T>::profile)) {
-      fdds::DataWriterQos q;  // a missing profile fails as create_datawriter_with_profile would
-      if (pub->get_datawriter_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
-        q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
-        w = pub->create_datawriter(topic, q);
-      }
-    } else {
-      w = pub->create_datawriter_with_profile(topic, Topic<T>::profile);
+    fdds::DataWriterQos q;  // a missing profile leaves w null
+    if (pub->get_datawriter_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
+      if (best_effort<T>()) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+      w = pub->create_datawriter(topic, q);
     }
     if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name + refused_hint(partition));
     return Writer<T>(w);
@@ -128,14 +123,10 @@ class Participant {
     auto listener = std::make_unique<Reader<T>>(std::move(handler));
     auto* sub = subscriber_for(partition);
     fdds::DataReader* r = nullptr;
-    if (best_effort(Topic<T>::profile)) {
-      fdds::DataReaderQos q;
-      if (sub->get_datareader_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
-        q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
-        r = sub->create_datareader(topic, q, listener.get());
-      }
-    } else {
-      r = sub->create_datareader_with_profile(topic, Topic<T>::profile, listener.get());
+    fdds::DataReaderQos q;
+    if (sub->get_datareader_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
+      if (best_effort<T>()) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+      r = sub->create_datareader(topic, q, listener.get());
     }
     if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));
     listener->attach(r);
@@ -163,9 +154,10 @@ class Participant {
   fdds::Subscriber* subscriber_for(const std::string& partition);
   /// Under DDS Security, why creating an endpoint may fail; empty otherwise.
   std::string refused_hint(const std::string& partition) const;
-  /// dds.best_effort_streams: the per-tick streams' profiles lose RELIABLE.
-  bool best_effort(std::string_view profile) const {
-    return best_effort_streams_ && (profile == "state" || profile == "command");
+  /// dds.best_effort_streams: the per-tick streams lose their profile's RELIABLE.
+  template <class T>
+  bool best_effort() const {
+    return best_effort_streams_ && kPerTickStream<T>;
   }
 
   template <class T>

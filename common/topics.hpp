@@ -79,6 +79,16 @@ inline constexpr bool kPerDronePartition = false;
 template <>
 inline constexpr bool kPerDronePartition<msg::VelocityCommand> = true;
 
+/// The per-tick streams, state out and commands back: a newer sample
+/// supersedes a lost one, so dds.best_effort_streams may drop their
+/// reliability (real time only).
+template <class T>
+inline constexpr bool kPerTickStream = false;
+template <>
+inline constexpr bool kPerTickStream<msg::SwarmState> = true;
+template <>
+inline constexpr bool kPerTickStream<msg::VelocityCommand> = true;
+
 /// Calls f.template operator()<T>() for every message type that has a topic
 /// (for tools that handle all of them: recorder, replay).
 template <class F>
