@@ -111,6 +111,13 @@ struct DdsCommander::Impl {
 
   /// Agents heard recently, plus those the server (the authority on
   /// liveness) reports live in its latest status.
+  /// The server is heard and count agents are online (count < 0: every drone).
+  bool online_at_least(int count) const {
+    if (!sim) return false;
+    const int want = count >= 0 ? count : sim->num_drones();
+    return online_locked().size() >= static_cast<std::size_t>(want);
+  }
+
   std::set<int> online_locked() const {
     std::set<int> out;
     double now = wall_seconds();
@@ -257,19 +264,11 @@ DdsCommander::DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds)
 DdsCommander::~DdsCommander() = default;
 
 bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
-  return impl_->wait(timeout_s, [&] {
-    if (!impl_->sim) return false;
-    int want = count >= 0 ? count : impl_->sim->num_drones();
-    return impl_->online_locked().size() >= static_cast<std::size_t>(want) && impl_->all_matched();
-  });
+  return impl_->wait(timeout_s, [&] { return impl_->online_at_least(count) && impl_->all_matched(); });
 }
 
 bool DdsCommander::wait_for_online(int count, double timeout_s) {
-  return impl_->wait(timeout_s, [&] {
-    if (!impl_->sim) return false;
-    int want = count >= 0 ? count : impl_->sim->num_drones();
-    return impl_->online_locked().size() >= static_cast<std::size_t>(want);
-  });
+  return impl_->wait(timeout_s, [&] { return impl_->online_at_least(count); });
 }
 
 bool DdsCommander::wait_for_server(double timeout_s) {
