@@ -48,13 +48,13 @@ Eigen::Vector3d repulsion_attraction(const Eigen::Vector3d& self,
                                      const ActivationConfig& a) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   auto acts = [&](double dist) { return dist > kTiny && !(a.cutoff_m > 0 && dist > a.cutoff_m); };
+  auto term = [&](const Eigen::Vector3d& p, double dist) -> Eigen::Vector3d {
+    return f_rel(dist - d_int, a) * ((p - self) / dist);
+  };
   const auto k = static_cast<std::size_t>(std::max(a.neighbours, 0));
   if (k == 0 || peers.size() <= k) {
-    for (const auto& p : peers) {
-      const Eigen::Vector3d delta = p - self;
-      const double dist = delta.norm();
-      if (acts(dist)) c += f_rel(dist - d_int, a) * (delta / dist);
-    }
+    for (const auto& p : peers)
+      if (const double dist = (p - self).norm(); acts(dist)) c += term(p, dist);
     return c;
   }
   // The k nearest: (distance, index) of every acting peer, partly sorted.
@@ -65,10 +65,7 @@ Eigen::Vector3d repulsion_attraction(const Eigen::Vector3d& self,
     if (const double dist = (peers[j] - self).norm(); acts(dist)) near.emplace_back(dist, j);
   const std::size_t n = std::min(k, near.size());
   if (near.size() > n) std::nth_element(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d delta = peers[near[i].second] - self;
-    c += f_rel(near[i].first - d_int, a) * (delta / near[i].first);
-  }
+  for (std::size_t i = 0; i < n; ++i) c += term(peers[near[i].second], near[i].first);
   return c;
 }
 

@@ -129,8 +129,8 @@ struct SimServer::Impl {
   std::uint64_t published_tick = 0;
   // What a ground station waits for changed since the last SimStatus: an
   // agent came online or was lost, accepted a new mission command, or changed
-  // phase. Set
-  // under mu; atomic so the per-tick check in publish_status needs no lock.
+  // phase. Set under mu; atomic so the per-tick check in publish_status needs
+  // no lock.
   std::atomic<bool> status_due{false};
   int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
   double agent_d_int = 0;
