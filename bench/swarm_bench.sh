@@ -29,7 +29,6 @@
 #   --set KEY=VALUE    scenario override for every swarm (ddswarm-launch --set), repeatable,
 #                      e.g. --set sim.physics_rate_hz=500
 #   --dds-profiles F   QoS profiles XML for every swarm process, the probe and the ground station
-#   --best-effort-streams   real time: state and commands best-effort (dds.best_effort_streams)
 #   --quick            a smoke run: N = 4 and 8, a few seconds each, 1 run per Table 1 set
 # Every process is started here or by ddswarm-launch and stopped by PID; every
 # run is bounded in time.
@@ -69,7 +68,6 @@ while [ $# -gt 0 ]; do
     --plot) PLOT="$2"; shift 2 ;;
     --set) SETS+=(--set "$2"); shift 2 ;;
     --dds-profiles) SETS+=(--set "dds.profiles_file=$(realpath "$2")"); PROFILE_ARGS+=(--dds-profiles "$(realpath "$2")"); shift 2 ;;
-    --best-effort-streams) SETS+=(--set dds.best_effort_streams=true); PROFILE_ARGS+=(--best-effort-streams); shift ;;
     --hosts-drones) HOSTS_N="$2"; shift 2 ;;
     --agent-hosts) HOSTS_K="$2"; shift 2 ;;
     --hosts-physics) HOSTS_PHYS="$2"; shift 2 ;;
