@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
     ddswarm::default_security_role(
         cfg.dds, cfg.drone_ids.size() == 1 ? "agent-" + std::to_string(cfg.drone_ids[0]) : "agent-host");
-    cfg.validate();
+    ddswarm::validate_with_overrides(config, [&] { cfg.validate(); });
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
     ddswarm::install_stop_signals();
     try {

@@ -79,4 +79,16 @@ void check_non_negative(const std::string& field, T v) {
     throw FieldError(field, to_text(v), "must be >= 0");
 }
 
+/// Validates a configuration that command-line options changed after its file
+/// was loaded: a FieldError then names the file too ("file: field = value:
+/// reason"), with no line, since the value may be the command line's.
+template <class Validate>
+void validate_with_overrides(const std::string& file, Validate&& validate) {
+  try {
+    validate();
+  } catch (const FieldError& e) {
+    throw ConfigError(file + ": " + e.what() + " (this file with the command line's options)");
+  }
+}
+
 }  // namespace ddswarm

@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
     // was killed; over loopback UDP, 0.15-0.25 s (docs/configuration.md).
     if (!file.gs.shared_memory) file.dds.shared_memory = false;
     default_security_role(file.dds, "gs");
-    file.dds.validate();
+    validate_with_overrides(config, [&] { file.dds.validate(); });
     install_stop_signals();
 
     if (!web_addr.empty()) {

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "common/cli_checks.hpp"
+#include "common/config_error.hpp"
 #include "common/process.hpp"
 #include "common/shm_clean.hpp"
 #include "sim_server/sim_server.hpp"
@@ -36,7 +37,7 @@ int main(int argc, char** argv) {
     if (mode) cfg.scenario.mode = *mode == "lockstep" ? ddswarm::TimeMode::kLockstep : ddswarm::TimeMode::kRealtime;
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
     ddswarm::default_security_role(cfg.dds, "server");
-    cfg.validate();
+    ddswarm::validate_with_overrides(scenario, [&] { cfg.validate(); });
     ddswarm::install_stop_signals();
     // Segments that crashed runs left in /dev/shm pile up until the next run
     // cannot map its own: clear the zombies (never a live process's) first.

@@ -64,6 +64,9 @@ case_ "sim: rate does not divide" 'bad_rate\.yaml:7:' 'sim\.control_rate_hz' '\b
 case_ "sim: negative sensor range" 'bad_sensor_range\.yaml:7:' 'sensors\.max_range_m' '-6' -- run_sim "$S/bad_sensor_range.yaml"
 case_ "sim: sensor range beyond the world" 'bad_sensor_beyond_world\.yaml:10:' 'sensors\.max_range_m' '\b600\b' "world's size" -- \
   run_sim "$S/bad_sensor_beyond_world.yaml"
+# A file that is fine alone, made invalid by a command-line option: the error names the file too.
+case_ "sim: --best-effort-streams in lockstep" 'thesis_course\.yaml: ' 'dds\.best_effort_streams = true' 'scenario\.mode: realtime' -- \
+  bounded "$BIN/ddswarm-sim" --scenario "$SRC/config/thesis_course.yaml" --mode lockstep --best-effort-streams --domain "$DOMAIN" --duration 1
 
 # The agent's own section and its drone id.
 case_ "agent: wrong type" 'bad_agent_wrong_type\.yaml:6:' 'agent\.inter_distance_m' 'far' -- run_agent "$S/bad_agent_wrong_type.yaml"
