@@ -14,9 +14,9 @@
 #                      step right after its state) and pipelined (sim.lockstep_pipeline:
 #                      physics runs while agents answer; commands act one tick later)
 #   --rt-time S        real-time seconds measured per N (default 60)
-#   --rt-streams best-effort|reliable   real time: the state and command streams' QoS
+#   --rt-streams best-effort|reliable   real time (per-drone processes and agent hosts): the state and command streams' QoS
 #                      (dds.best_effort_streams; default best-effort)
-#   --rt-grace G       real time: sim.realtime_grace, the share of a period the server waits
+#   --rt-grace G       real time (both): sim.realtime_grace, the share of a period the server waits
 #                      for late answers (default 0.6; the shipped default is 0.25)
 #   --floor-time S     floor seconds measured per N (default 5)
 #   --skip floor,lockstep,realtime,hosts,table1   parts to leave out
@@ -231,14 +231,17 @@ if ! skip lockstep; then
 fi
 
 # ---------------------------------------------------------------- real time
+# Real time, process per drone and agent hosts alike: the streams' QoS and the grace.
+case "$RT_STREAMS" in
+  best-effort) RT_EXTRA=(--set dds.best_effort_streams=true); RT_TOOL_ARGS=(--best-effort-streams) ;;
+  reliable) RT_EXTRA=(); RT_TOOL_ARGS=() ;;
+  *) echo "swarm_bench: --rt-streams must be best-effort or reliable, not '$RT_STREAMS'" >&2; exit 2 ;;
+esac
+RT_EXTRA+=(--set "sim.realtime_grace=$RT_GRACE")
+
 if ! skip realtime; then
   : >"$OUT/realtime.txt"
-  case "$RT_STREAMS" in
-    best-effort) RUN_EXTRA=(--set dds.best_effort_streams=true); RUN_TOOL_ARGS=(--best-effort-streams) ;;
-    reliable) RUN_EXTRA=(); RUN_TOOL_ARGS=() ;;
-    *) echo "swarm_bench: --rt-streams must be best-effort or reliable, not '$RT_STREAMS'" >&2; exit 2 ;;
-  esac
-  RUN_EXTRA+=(--set "sim.realtime_grace=$RT_GRACE")
+  RUN_EXTRA=("${RT_EXTRA[@]}"); RUN_TOOL_ARGS=("${RT_TOOL_ARGS[@]}")
   for n in $RT_SIZES; do
     echo "swarm_bench: real time N=$n, ${RT_TIME} s (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
     echo "$(run_swarm realtime "$n" "$RT_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/realtime.txt"
@@ -268,15 +271,17 @@ fi
 # ---------------------------------------------------------------- agent hosts
 if ! skip hosts; then
   RUN_SCENARIO="$SRC/config/swarm_field.yaml"  # its ground-station timeouts already allow 512 drones
-  RUN_EXTRA=(--agent-hosts "$HOSTS_K" --set "sim.physics_rate_hz=$HOSTS_PHYS" --set "sim.sensor_rate_hz=$HOSTS_SENS")
+  RUN_EXTRA=("${RT_EXTRA[@]}" --agent-hosts "$HOSTS_K" --set "sim.physics_rate_hz=$HOSTS_PHYS"
+             --set "sim.sensor_rate_hz=$HOSTS_SENS")
+  RUN_TOOL_ARGS=("${RT_TOOL_ARGS[@]}")
   RUN_TAG="-hosts"
   echo "swarm_bench: agent hosts, $HOSTS_N drones in $HOSTS_K processes, real time ${RT_TIME} s (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
   l="$(run_swarm realtime "$HOSTS_N" "$RT_TIME") load=$(cut -d' ' -f1 /proc/loadavg)"
-  RUN_SCENARIO=""; RUN_EXTRA=(); RUN_TAG=""
+  RUN_SCENARIO=""; RUN_EXTRA=(); RUN_TOOL_ARGS=(); RUN_TAG=""
   echo "$l" >"$OUT/hosts.txt"
   rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l")
   echo
-  echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, ${RT_TIME} s =="
+  echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, $RT_STREAMS state and commands, realtime_grace $RT_GRACE, ${RT_TIME} s =="
   echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | host RSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
   printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
