@@ -54,12 +54,15 @@ msg::SwarmState make_state(int n) {
 }
 
 std::string g_profiles;  // --profiles: a QoS profiles file other than ddswarm's
+double g_work_us = 0;  // --work-us: the publisher's CPU between ticks, standing in for physics
+bool g_best_effort = false;  // --best-effort-streams: as dds.best_effort_streams
 
 DdsConfig dds_for(int domain, const std::string& server, int participant_id = -1) {
   DdsConfig c;
   if (!g_profiles.empty()) c.profiles_file = g_profiles;
   c.domain_id = domain;
   c.participant_id = participant_id;
+  c.best_effort_streams = g_best_effort;
   if (!server.empty()) {
     c.discovery = Discovery::kDiscoveryServer;
     c.discovery_server = server;
@@ -132,6 +135,7 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
     std::vector<std::string> a = {self_exe(), "--respond", std::to_string(i), "--domain", std::to_string(domain),
                                   "--duration", fmt::format("{:.0f}", child_budget)};
     if (!g_profiles.empty()) a.insert(a.end(), {"--profiles", g_profiles});
+    if (g_best_effort) a.push_back("--best-effort-streams");
     if (use_server) {
       a.push_back("--discovery-server");
       a.push_back(server);
@@ -217,6 +221,11 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
             break;
           }
         }
+        if (g_work_us > 0) {  // busy, as a physics step is: no sleep, no yield
+          const double until = wall_seconds() + g_work_us * 1e-6;
+          while (wall_seconds() < until) {
+          }
+        }
         publish(tick);
       }
       auto procs = sample_all(kids, false);
@@ -263,6 +272,13 @@ int main(int argc, char** argv) {
     app.add_option("--domain", domain, "DDS domain (default: random in 20-79, whose RTPS ports stay below the ephemeral port range)");
     app.add_option("--profiles", g_profiles, "QoS profiles XML (default: ddswarm's config/dds_profiles.xml)")
         ->check(CLI::ExistingFile);
+    app.add_option("--work-us", g_work_us,
+                   "µs the publisher spends busy between ticks, as a server steps physics there "
+                   "(0: none, the floor)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_flag("--best-effort-streams", g_best_effort,
+                 "swarm state and commands best-effort, as dds.best_effort_streams (a lost tick is "
+                 "re-published after 0.25 s)");
     app.add_option("--csv", csv, "append one row per run to this CSV");
     app.add_option("--log-dir", log_dir, "responder and discovery-server logs (default: discarded)");
     app.add_flag("--explicit-ids", explicit_ids,
