@@ -32,6 +32,10 @@ std::string TaskOutcome::line() const {
 }
 
 namespace {
+/// Seconds without a new ack writer matched after which a ground station
+/// stops waiting for the rest (wait_for_server).
+constexpr double kMatchQuietS = 2.0;
+
 struct AgentSeen {
   double wall = -1e9;
   double d_int = 0;
@@ -279,8 +283,21 @@ bool DdsCommander::wait_for_server(double timeout_s) {
   // Then every live agent's ack writer, for up to the ack timeout: an ack
   // written before it matched our reader could be lost. A frozen or
   // unreachable agent never matches, so go on after that and let the
-  // acknowledgements name whoever stays silent.
-  I.wait(I.cfg.ack_timeout_s, everyone);
+  // acknowledgements name whoever stays silent. Nor does an agent whose
+  // writer Fast DDS leaves unmatched (at 128 processes, after a re-join): it
+  // would hold every command for the whole timeout, though the server relays
+  // what it accepts. So stop waiting, too, once no writer has matched for
+  // kMatchQuietS.
+  int matched = -1;
+  double since = wall_seconds();
+  I.wait(I.cfg.ack_timeout_s, [&] {
+    if (everyone()) return true;
+    if (const int m = I.ack_reader->matched(); m != matched) {
+      matched = m;
+      since = wall_seconds();
+    }
+    return wall_seconds() - since > kMatchQuietS;
+  });
   return !stop_requested();
 }
 
