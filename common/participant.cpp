@@ -6,6 +6,8 @@
 #include <fastrtps/utils/IPLocator.h>
 
 #include <filesystem>
+#include <mutex>
+#include <optional>
 
 namespace ddswarm {
 namespace {
@@ -137,7 +139,28 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
   return qos;
 }
 
+/// This process's participants so far: the first one's GUID prefix, and how
+/// many have been made (incarnation_prefix).
+struct ProcessParticipants {
+  std::mutex mu;
+  std::optional<eprosima::fastrtps::rtps::GuidPrefix_t> first;
+  std::uint32_t made = 0;
+};
+ProcessParticipants& process_participants() {
+  static ProcessParticipants p;
+  return p;
+}
+
 }  // namespace
+
+eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
+                                                          std::uint32_t n) {
+  auto p = first;
+  p.value[9] = static_cast<eprosima::fastrtps::rtps::octet>(n & 0xff);
+  p.value[10] = static_cast<eprosima::fastrtps::rtps::octet>((n >> 8) & 0xff);
+  p.value[11] = static_cast<eprosima::fastrtps::rtps::octet>((n >> 16) & 0xff);
+  return p;
+}
 
 Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   cfg.validate();
@@ -146,7 +169,25 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   secure_ = cfg.secure();
   best_effort_streams_ = cfg.best_effort_streams;
   role_ = cfg.security_role;
-  participant_ = factory->create_participant(cfg.domain_id, make_qos(cfg, name));
+  auto qos = make_qos(cfg, name);
+  {
+    // A new GUID for every participant of this process: Fast DDS 2.9 builds
+    // the prefix from the host, the process and the participant id, so an
+    // agent that left DDS and joined again came back under the very GUID it
+    // had left with. Its discovery server then took the new participant's
+    // endpoints for the departed one's ("Writer ... has no associated
+    // participant. Skipping") and never matched them, and the agent had to
+    // re-join again (docs/performance.md). Not under DDS Security, whose
+    // authentication derives the prefix itself.
+    auto& pp = process_participants();
+    std::lock_guard<std::mutex> lock(pp.mu);
+    if (pp.first && !secure_) qos.wire_protocol().prefix = incarnation_prefix(*pp.first, pp.made);
+    participant_ = factory->create_participant(cfg.domain_id, qos);
+    if (participant_) {
+      if (!pp.first) pp.first = participant_->guid().guidPrefix;
+      ++pp.made;
+    }
+  }
   if (!participant_)
     throw DdsError("cannot create DDS participant on domain " + std::to_string(cfg.domain_id) +
                    (secure_ ? " with DDS Security as " + role_ + " (credentials in " + cfg.security_dir +

@@ -85,6 +85,14 @@ class Reader : public fdds::DataReaderListener {
   T sample_;
 };
 
+/// The GUID prefix of a process's participant number n (n >= 1; the first,
+/// number 0, has Fast DDS's own): the first's host and process bytes, n in
+/// the last three bytes, where Fast DDS's prefixes hold zeros (the
+/// participant id's upper bytes), so it is unique in the process and on the
+/// host, and Fast DDS still sees one host and one process.
+eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
+                                                          std::uint32_t n);
+
 class Participant {
  public:
   /// Joins the domain; throws DdsError naming what failed. name shows in tools.
