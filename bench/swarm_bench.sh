@@ -234,7 +234,8 @@ fi
 # Real time, process per drone and agent hosts alike: the streams' QoS and the grace.
 case "$RT_STREAMS" in
   best-effort) RT_EXTRA=(--set dds.best_effort_streams=true); RT_TOOL_ARGS=(--best-effort-streams) ;;
-  reliable) RT_EXTRA=(); RT_TOOL_ARGS=() ;;
+  # Explicitly: config/swarm_field.yaml, which the agent-host part flies, ships best-effort.
+  reliable) RT_EXTRA=(--set dds.best_effort_streams=false); RT_TOOL_ARGS=(--best-effort-streams=false) ;;
   *) echo "swarm_bench: --rt-streams must be best-effort or reliable, not '$RT_STREAMS'" >&2; exit 2 ;;
 esac
 RT_EXTRA+=(--set "sim.realtime_grace=$RT_GRACE")
