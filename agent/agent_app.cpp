@@ -470,6 +470,12 @@ struct AgentApp::Impl {
     else
       spdlog::info("{}: flying drones {}..{} (pid {})", label, brains.front()->id, brains.back()->id, getpid());
     while (!stop_requested() && wall_seconds() < end) {
+      if (take_rejoin_request()) {
+        spdlog::warn("{}: asked to join again (SIGUSR1: the discovery server dropped this participant's "
+                     "endpoints); leaving DDS and joining again as a new participant",
+                     label);
+        return AgentApp::End::kRejoinRequested;
+      }
       publish_status();
       {
         std::lock_guard<std::mutex> lock(mu);

@@ -42,10 +42,11 @@ class AgentApp {
   /// Joins DDS and checks that no other agent flies this drone (throws DuplicateAgent).
   explicit AgentApp(AgentAppConfig cfg);
   ~AgentApp();
-  enum class End { kStopped, kNoScene };
+  enum class End { kStopped, kNoScene, kRejoinRequested };
   /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
   /// kStopped. kNoScene when no scene came within agent.rejoin_after_s of
-  /// joining: the caller should destroy this app and join again.
+  /// joining, kRejoinRequested on take_rejoin_request() (SIGUSR1): the caller
+  /// should destroy this app and join again.
   End run(double duration_s);
 
  private:

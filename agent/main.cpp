@@ -64,10 +64,12 @@ int main(int argc, char** argv) {
     ddswarm::validate_with_overrides(config, [&] { cfg.validate(); });
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
     ddswarm::install_stop_signals();
+    ddswarm::install_rejoin_signal();
     try {
       using ddswarm::agent::AgentApp;
       const double end = duration_s > 0 ? ddswarm::wall_seconds() + duration_s : 0;
-      while (!ddswarm::stop_requested()) {  // a new participant each time no scene came (agent.rejoin_after_s)
+      // A new participant each time no scene came (agent.rejoin_after_s) or SIGUSR1 asked for one.
+      while (!ddswarm::stop_requested()) {
         const double left = end > 0 ? end - ddswarm::wall_seconds() : 0;
         if (end > 0 && left <= 0) break;
         AgentApp agent(cfg);

@@ -18,8 +18,20 @@ std::atomic<bool> g_stop{false};
 std::mutex g_mu;
 std::condition_variable g_cv;
 
+std::atomic<bool> g_rejoin{false};
+
 extern "C" void on_signal(int) { g_stop.store(true); }
+extern "C" void on_rejoin_signal(int) { g_rejoin.store(true); }
 }  // namespace
+
+void install_rejoin_signal() {
+  struct sigaction sa {};
+  sa.sa_handler = on_rejoin_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGUSR1, &sa, nullptr);
+}
+
+bool take_rejoin_request() { return g_rejoin.exchange(false); }
 
 void install_stop_signals() {
   struct sigaction sa {};

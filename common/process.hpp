@@ -15,6 +15,13 @@ void request_stop();
 /// Sleeps until a stop is requested or d elapses; returns stop_requested().
 bool wait_for_stop(std::chrono::duration<double> d);
 
+/// SIGUSR1 asks the process to leave DDS and join again as a new participant
+/// (ddswarm-launch sends it to an agent whose endpoints its discovery server
+/// dropped). Installs the handler (idempotent).
+void install_rejoin_signal();
+/// True once per SIGUSR1 received since the last call.
+bool take_rejoin_request();
+
 /// Runs body; maps ConfigError/CLI errors to exit 2, other exceptions to exit 1,
 /// printing "<prog>: error: <what>" on one line.
 int run_main(const char* prog, const std::function<int()>& body);

@@ -23,4 +23,15 @@ timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" takeoff --w
 [ "$(grep -c "joining again" "$WORK/agent.log")" -eq "$n" ] || fail "the agent kept re-joining after it had the scene"
 grep -q "drone 0: agent .* online" "$WORK/sim.log" || fail "the server never saw the agent"
 echo "re-joined $n times before the server came; then flew"
+# SIGUSR1 (what ddswarm-launch sends when its discovery server dropped the
+# agent's endpoints): the agent joins again at once, as a new participant the
+# server adopts, and its drone, in the air, keeps flying under it.
+kill -USR1 "$PID_agent"
+for _ in $(seq "$(slow 100)"); do grep -q "asked to join again" "$WORK/agent.log" && break; sleep 0.1; done
+grep -q "asked to join again" "$WORK/agent.log" || fail "SIGUSR1 did not make the agent join again"
+kill -0 "$PID_agent" 2>/dev/null || fail "SIGUSR1 ended the agent"
+for _ in $(seq "$(slow 200)"); do [ "$(grep -c "scene 'thesis_course' received" "$WORK/agent.log")" -ge 2 ] && break; sleep 0.1; done
+[ "$(grep -c "scene 'thesis_course' received" "$WORK/agent.log")" -ge 2 ] || fail "the agent did not get the scene after joining again"
+timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" land --wait || fail "the drone did not land after its agent joined again"
+echo "joined again on SIGUSR1, then landed"
 echo PASS
