@@ -188,6 +188,7 @@ int main(int argc, char** argv) {
       // First, so every participant finds it; clients retry until it answers.
       const int port = free_udp_port();
       procs.start(discovery_server_spec(port));
+      procs.rejoin_dropped_agents("discovery-server");
       const std::string address = "127.0.0.1:" + std::to_string(port);
       dds_args.push_back("--discovery-server");
       dds_args.push_back(address);

@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -104,12 +105,43 @@ pid_t Launcher::start(const ChildSpec& spec) {
   return pid;
 }
 
+void Launcher::rejoin_dropped_agents(const std::string& ds_name) {
+  std::lock_guard<std::mutex> lock(mu_);
+  drop_watch_ = ds_name;
+}
+
+void Launcher::on_dropped(const std::array<std::uint8_t, 12>& prefix) {
+  if (!dropped_seen_.insert(prefix).second) return;  // one participant: several endpoint lines
+  std::string guid;
+  for (auto b : prefix) guid += fmt::format("{}{:02x}", guid.empty() ? "" : ".", b);
+  const int pid16 = prefix_pid16(prefix);
+  bool found = false;
+  for (const auto& [pid, c] : live_) {
+    if ((pid & 0xffff) != pid16) continue;
+    found = true;
+    if (c->name.rfind("agent", 0) == 0) {
+      std::cerr << "ddswarm-launch: the discovery server dropped " << c->name << "'s endpoints (participant "
+                << guid << "); asking it to join again\n";
+      kill(pid, SIGUSR1);
+    } else {
+      std::cerr << "ddswarm-launch: warning: the discovery server dropped " << c->name
+                << "'s endpoints (participant " << guid
+                << "); it will not match the participants that joined before it (Fast DDS 2.9)\n";
+    }
+  }
+  if (!found)  // a tool that joined by itself: it says so when it finds no server
+    std::cerr << "ddswarm-launch: the discovery server dropped the endpoints of participant " << guid
+              << ", not one of this launch's processes\n";
+}
+
 void Launcher::emit(Child& c, const char* data, std::size_t n, bool flush) {
   c.partial.append(data, n);
   std::size_t start = 0, nl;
   while ((nl = c.partial.find('\n', start)) != std::string::npos || (flush && start < c.partial.size())) {
     std::size_t end = nl == std::string::npos ? c.partial.size() : nl;
     std::string line = c.partial.substr(start, end - start);
+    if (!drop_watch_.empty() && c.name == drop_watch_)
+      if (auto prefix = dropped_participant_prefix(line)) on_dropped(*prefix);
     if (c.log) {
       fprintf(c.log, "%s\n", line.c_str());
       fflush(c.log);
@@ -295,6 +327,34 @@ ChildSpec discovery_server_spec(int port) {
           {exe, "-i", "0", "-l", "127.0.0.1", "-p", std::to_string(port), "-x",
            std::string(DDSWARM_CONFIG_DIR) + "/discovery_server.xml"}};
 }
+
+std::optional<std::array<std::uint8_t, 12>> dropped_participant_prefix(const std::string& line) {
+  if (line.find("has no associated participant") == std::string::npos) return std::nullopt;
+  std::string plain;  // without ANSI colour codes (ESC [ ... letter)
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    if (line[i] == '\x1b' && i + 1 < line.size() && line[i + 1] == '[') {
+      i += 2;
+      while (i < line.size() && !std::isalpha(static_cast<unsigned char>(line[i]))) ++i;
+      continue;
+    }
+    plain += line[i];
+  }
+  // "<12 hex pairs separated by dots>|<entity id>"
+  const auto bar = plain.find('|');
+  if (bar == std::string::npos || bar < 35) return std::nullopt;
+  const std::string guid = plain.substr(bar - 35, 35);
+  std::array<std::uint8_t, 12> out{};
+  for (int k = 0; k < 12; ++k) {
+    const std::string byte = guid.substr(3 * k, 2);
+    if (!std::isxdigit(static_cast<unsigned char>(byte[0])) || !std::isxdigit(static_cast<unsigned char>(byte[1])) ||
+        (k < 11 && guid[3 * k + 2] != '.'))
+      return std::nullopt;
+    out[k] = static_cast<std::uint8_t>(std::stoi(byte, nullptr, 16));
+  }
+  return out;
+}
+
+int prefix_pid16(const std::array<std::uint8_t, 12>& prefix) { return prefix[4] | (prefix[5] << 8); }
 
 int free_udp_port() {
   int s = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);

@@ -3,11 +3,15 @@
 // says which one died and why, and tears everything down cleanly.
 #include <sys/types.h>
 
+#include <array>
 #include <atomic>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -48,6 +52,11 @@ class Launcher {
   std::vector<ChildExit> stop_all(double grace_s = 3.0);
   /// Sends sig to one child by name (tests, fault injection).
   bool signal(const std::string& name, int sig);
+  /// Reads child `ds_name`'s output as a Fast DDS discovery server's: when it
+  /// drops a participant's endpoints for good (dropped_participant_prefix),
+  /// the agent child whose process that participant is gets SIGUSR1 (join
+  /// again), once per participant, and the launcher says so on stderr.
+  void rejoin_dropped_agents(const std::string& ds_name);
 
   /// Directory of the running executable (where the sibling binaries live).
   static std::string self_dir();
@@ -62,6 +71,10 @@ class Launcher {
   };
   void pump();
   void emit(Child& c, const char* data, std::size_t n, bool flush);
+  void on_dropped(const std::array<std::uint8_t, 12>& prefix);  ///< mu_ held
+
+  std::string drop_watch_;                              ///< rejoin_dropped_agents
+  std::set<std::array<std::uint8_t, 12>> dropped_seen_;  ///< participants already acted on
 
   std::string log_dir_;
   mutable std::mutex mu_;
@@ -134,5 +147,16 @@ ChildSpec discovery_server_spec(int port);
 
 /// A UDP port on 127.0.0.1 that was free a moment ago.
 int free_udp_port();
+
+/// The GUID prefix in a line of fast-discovery-server's log that says it
+/// dropped a participant's endpoint for good ("Writer <prefix>|<entity> has no
+/// associated participant. Skipping": Fast DDS 2.9 processed the endpoint
+/// before its participant, and never matches it afterwards; docs/performance.md),
+/// or nothing. Colour codes are ignored.
+std::optional<std::array<std::uint8_t, 12>> dropped_participant_prefix(const std::string& line);
+
+/// The low 16 bits of the process id in a Fast DDS 2.9 GUID prefix (bytes 4-5,
+/// little-endian): which process a participant lives in.
+int prefix_pid16(const std::array<std::uint8_t, 12>& prefix);
 
 }  // namespace ddswarm::gs

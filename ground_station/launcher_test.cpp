@@ -34,6 +34,46 @@ TEST(Launcher, ReportsWhichChildDiedAndWhy) {
   EXPECT_NE(exits[0].describe().find("killed by SIGKILL"), std::string::npos);
 }
 
+TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
+  // As fast-discovery-server 2.9 prints it, colours and all.
+  const std::string line =
+      "\x1b[37;1m2026-11-21 21:17:38.547 \x1b[31;1m[\x1b[37;1mDISCOVERY_DATABASE\x1b[31;1m Error] \x1b[37mWriter "
+      "01.0f.78.fd.33.40.d6.23.25.00.00.00|0.0.1.2 has no associated participant. Skipping\x1b[34;1m -> Function "
+      "\x1b[36mcreate_writers_from_change_\x1b[m";
+  auto p = dropped_participant_prefix(line);
+  ASSERT_TRUE(p);
+  const std::array<std::uint8_t, 12> want = {0x01, 0x0f, 0x78, 0xfd, 0x33, 0x40, 0xd6, 0x23, 0x25, 0, 0, 0};
+  EXPECT_EQ(*p, want);
+  EXPECT_EQ(prefix_pid16(*p), 16435);  // the agent's pid in that run, 0x4033
+  EXPECT_FALSE(dropped_participant_prefix("Attempting to delete and orphan reader -> Function delete_reader_entity_"));
+  EXPECT_FALSE(dropped_participant_prefix("### Server is running ###"));
+  EXPECT_FALSE(dropped_participant_prefix("Writer 01.0f.zz|0.0.1.2 has no associated participant. Skipping"));
+}
+
+TEST(Launcher, AsksAnAgentWhoseEndpointsTheDiscoveryServerDroppedToJoinAgain) {
+  Launcher l(::testing::TempDir() + "/launcher_drop_logs");
+  l.rejoin_dropped_agents("discovery-server");
+  // An "agent" that exits 42 on SIGUSR1, and one that must not get it.
+  const pid_t agent = l.start({"agent 5", {"/bin/sh", "-c", "trap 'exit 42' USR1; while :; do sleep 0.05; done"}});
+  l.start({"agent 6", {"/bin/sh", "-c", "trap 'exit 43' USR1; while :; do sleep 0.05; done"}});
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // both have their traps
+  char guid[64];
+  std::snprintf(guid, sizeof guid, "01.0f.78.fd.%02x.%02x.d6.23.25.00.00.00", agent & 0xff, (agent >> 8) & 0xff);
+  const std::string msg = std::string("Writer ") + guid + "|0.0.1.2 has no associated participant. Skipping";
+  l.start({"discovery-server", {"/bin/sh", "-c", "echo '" + msg + "'; echo '" + msg + "'; sleep 30"}});
+  std::vector<ChildExit> exits;
+  for (int i = 0; i < 150 && exits.empty(); ++i) {
+    exits = l.reap();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(exits.size(), 1u);
+  EXPECT_EQ(exits[0].pid, agent);
+  EXPECT_EQ(exits[0].exit_code, 42);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_TRUE(l.reap().empty()) << "agent 6 was asked to join again too";
+  l.stop_all(0.5);
+}
+
 TEST(Launcher, StopAllLeavesNoChildBehind) {
   std::vector<pid_t> pids;
   {
