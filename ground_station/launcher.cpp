@@ -110,7 +110,12 @@ void Launcher::rejoin_dropped_agents(const std::string& ds_name) {
   drop_watch_ = ds_name;
 }
 
-void Launcher::on_dropped(const std::array<std::uint8_t, 12>& prefix) {
+void Launcher::on_dropped(const std::array<std::uint8_t, 12>& prefix, bool server_only) {
+  if (server_only) {
+    bool server = false;
+    for (const auto& [pid, c] : live_) server |= (pid & 0xffff) == prefix_pid16(prefix) && c->name == "sim";
+    if (!server) return;
+  }
   if (!dropped_seen_.insert(prefix).second) return;  // one participant: several endpoint lines
   std::string guid;
   for (auto b : prefix) guid += fmt::format("{}{:02x}", guid.empty() ? "" : ".", b);
@@ -119,14 +124,14 @@ void Launcher::on_dropped(const std::array<std::uint8_t, 12>& prefix) {
   for (const auto& [pid, c] : live_) {
     if ((pid & 0xffff) != pid16) continue;
     found = true;
-    if (c->name.rfind("agent", 0) == 0) {
+    if (c->name.rfind("agent", 0) == 0 || c->name == "sim") {
       std::cerr << "ddswarm-launch: the discovery server dropped " << c->name << "'s endpoints (participant "
                 << guid << "); asking it to join again\n";
       kill(pid, SIGUSR1);
     } else {
       std::cerr << "ddswarm-launch: warning: the discovery server dropped " << c->name
                 << "'s endpoints (participant " << guid
-                << "); it will not match the participants that joined before it (Fast DDS 2.9)\n";
+                << "); Fast DDS 2.9 never matches them afterwards\n";
     }
   }
   if (!found)  // a tool that joined by itself: it says so when it finds no server
@@ -140,8 +145,10 @@ void Launcher::emit(Child& c, const char* data, std::size_t n, bool flush) {
   while ((nl = c.partial.find('\n', start)) != std::string::npos || (flush && start < c.partial.size())) {
     std::size_t end = nl == std::string::npos ? c.partial.size() : nl;
     std::string line = c.partial.substr(start, end - start);
-    if (!drop_watch_.empty() && c.name == drop_watch_)
-      if (auto prefix = dropped_participant_prefix(line)) on_dropped(*prefix);
+    if (!drop_watch_.empty() && c.name == drop_watch_) {
+      if (auto prefix = dropped_participant_prefix(line)) on_dropped(*prefix, false);
+      if (auto prefix = unmatched_participant_prefix(line)) on_dropped(*prefix, true);
+    }
     if (c.log) {
       fprintf(c.log, "%s\n", line.c_str());
       fflush(c.log);
@@ -328,8 +335,9 @@ ChildSpec discovery_server_spec(int port) {
            std::string(DDSWARM_CONFIG_DIR) + "/discovery_server.xml"}};
 }
 
-std::optional<std::array<std::uint8_t, 12>> dropped_participant_prefix(const std::string& line) {
-  if (line.find("has no associated participant") == std::string::npos) return std::nullopt;
+namespace {
+/// The GUID prefix right before the first '|' of a log line, colour codes aside.
+std::optional<std::array<std::uint8_t, 12>> prefix_before_bar(const std::string& line) {
   std::string plain;  // without ANSI colour codes (ESC [ ... letter)
   for (std::size_t i = 0; i < line.size(); ++i) {
     if (line[i] == '\x1b' && i + 1 < line.size() && line[i + 1] == '[') {
@@ -352,6 +360,17 @@ std::optional<std::array<std::uint8_t, 12>> dropped_participant_prefix(const std
     out[k] = static_cast<std::uint8_t>(std::stoi(byte, nullptr, 16));
   }
   return out;
+}
+}  // namespace
+
+std::optional<std::array<std::uint8_t, 12>> dropped_participant_prefix(const std::string& line) {
+  if (line.find("has no associated participant") == std::string::npos) return std::nullopt;
+  return prefix_before_bar(line);
+}
+
+std::optional<std::array<std::uint8_t, 12>> unmatched_participant_prefix(const std::string& line) {
+  if (line.find("Matching unexisting participant from") == std::string::npos) return std::nullopt;
+  return prefix_before_bar(line);
 }
 
 int prefix_pid16(const std::array<std::uint8_t, 12>& prefix) { return prefix[4] | (prefix[5] << 8); }

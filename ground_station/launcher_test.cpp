@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <map>
 #include <thread>
 
 using namespace ddswarm::gs;
@@ -48,29 +49,54 @@ TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
   EXPECT_FALSE(dropped_participant_prefix("Attempting to delete and orphan reader -> Function delete_reader_entity_"));
   EXPECT_FALSE(dropped_participant_prefix("### Server is running ###"));
   EXPECT_FALSE(dropped_participant_prefix("Writer 01.0f.zz|0.0.1.2 has no associated participant. Skipping"));
+  const std::string unmatched =
+      "\x1b[37;1m2026-11-21 21:23:27.666 \x1b[31;1m[\x1b[37;1mDISCOVERY_DATABASE\x1b[31;1m Error] \x1b[37mMatching "
+      "unexisting participant from writer 01.0f.78.fd.b5.74.d4.24.00.00.00.00|0.0.1.3\x1b[34;1m -> Function "
+      "\x1b[36mmatch_writer_reader_\x1b[m";
+  auto u = unmatched_participant_prefix(unmatched);
+  ASSERT_TRUE(u);
+  EXPECT_EQ(prefix_pid16(*u), 0x74b5);
+  EXPECT_FALSE(dropped_participant_prefix(unmatched));
+  EXPECT_FALSE(unmatched_participant_prefix(line));
 }
 
 TEST(Launcher, AsksAnAgentWhoseEndpointsTheDiscoveryServerDroppedToJoinAgain) {
   Launcher l(::testing::TempDir() + "/launcher_drop_logs");
   l.rejoin_dropped_agents("discovery-server");
-  // An "agent" that exits 42 on SIGUSR1, and one that must not get it.
-  const pid_t agent = l.start({"agent 5", {"/bin/sh", "-c", "trap 'exit 42' USR1; while :; do sleep 0.05; done"}});
-  l.start({"agent 6", {"/bin/sh", "-c", "trap 'exit 43' USR1; while :; do sleep 0.05; done"}});
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // both have their traps
-  char guid[64];
-  std::snprintf(guid, sizeof guid, "01.0f.78.fd.%02x.%02x.d6.23.25.00.00.00", agent & 0xff, (agent >> 8) & 0xff);
-  const std::string msg = std::string("Writer ") + guid + "|0.0.1.2 has no associated participant. Skipping";
-  l.start({"discovery-server", {"/bin/sh", "-c", "echo '" + msg + "'; echo '" + msg + "'; sleep 30"}});
-  std::vector<ChildExit> exits;
-  for (int i = 0; i < 150 && exits.empty(); ++i) {
-    exits = l.reap();
+  // Children that exit with a code of their own on SIGUSR1.
+  auto on_usr1 = [](int code) {
+    return std::vector<std::string>{"/bin/sh", "-c",
+                                    "trap 'exit " + std::to_string(code) + "' USR1; while :; do sleep 0.05; done"};
+  };
+  const pid_t agent5 = l.start({"agent 5", on_usr1(42)});
+  const pid_t agent6 = l.start({"agent 6", on_usr1(43)});
+  const pid_t sim = l.start({"sim", on_usr1(44)});
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // all have their traps
+  auto guid = [](pid_t pid) {
+    char g[64];
+    std::snprintf(g, sizeof g, "01.0f.78.fd.%02x.%02x.d6.23.25.00.00.00", pid & 0xff, (pid >> 8) & 0xff);
+    return std::string(g);
+  };
+  // Agent 5's endpoints dropped (twice: one signal); "Matching unexisting
+  // participant" for agent 6, which may just have left: no signal; for the
+  // server, which never leaves by itself: a signal.
+  const std::string dropped = "Writer " + guid(agent5) + "|0.0.1.2 has no associated participant. Skipping";
+  const std::string unmatched6 = "Matching unexisting participant from writer " + guid(agent6) + "|0.0.1.3";
+  const std::string unmatched_sim = "Matching unexisting participant from reader " + guid(sim) + "|0.0.4.7";
+  l.start({"discovery-server", {"/bin/sh", "-c",
+                                "echo '" + dropped + "'; echo '" + dropped + "'; echo '" + unmatched6 + "'; echo '" +
+                                    unmatched_sim + "'; sleep 30"}});
+  std::map<pid_t, int> codes;
+  for (int i = 0; i < 150 && codes.size() < 2; ++i) {
+    for (const auto& e : l.reap()) codes[e.pid] = e.exit_code;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  ASSERT_EQ(exits.size(), 1u);
-  EXPECT_EQ(exits[0].pid, agent);
-  EXPECT_EQ(exits[0].exit_code, 42);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  EXPECT_TRUE(l.reap().empty()) << "agent 6 was asked to join again too";
+  for (const auto& e : l.reap()) codes[e.pid] = e.exit_code;
+  EXPECT_EQ(codes.size(), 2u);
+  EXPECT_EQ(codes[agent5], 42);
+  EXPECT_EQ(codes[sim], 44);
+  EXPECT_EQ(codes.count(agent6), 0u) << "agent 6 was asked to join again";
   l.stop_all(0.5);
 }
 

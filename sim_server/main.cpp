@@ -44,8 +44,14 @@ int main(int argc, char** argv) {
     if (auto r = ddswarm::clean_zombie_shm(); r.files_removed > 0)
       spdlog::info("removed {} shared-memory files ({:.1f} MB) left by crashed processes",
                    r.files_removed, r.bytes_freed / 1e6);
-    ddswarm::sim::SimServer server(std::move(cfg));
-    server.run(duration_s);
+    ddswarm::install_rejoin_signal();
+    const double end = duration_s > 0 ? ddswarm::wall_seconds() + duration_s : 0;
+    while (!ddswarm::stop_requested()) {  // a new server each time SIGUSR1 asks before a mission (SimServer::run)
+      const double left = end > 0 ? end - ddswarm::wall_seconds() : 0;
+      if (end > 0 && left <= 0) break;
+      ddswarm::sim::SimServer server(cfg);
+      if (server.run(left) != ddswarm::sim::SimServer::End::kRejoinRequested) break;
+    }
     return 0;
   });
 }

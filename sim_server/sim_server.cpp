@@ -125,6 +125,7 @@ struct SimServer::Impl {
   std::deque<msg::MissionCommand> pending_missions;
   std::vector<msg::Beacon> pending_beacons;  // carried by accepted commands, forwarded next tick
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
+  bool rejoin = false;  // run() ended on a rejoin request (rejoin_now)
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   // What a ground station waits for changed since the last SimStatus: an
@@ -724,6 +725,22 @@ struct SimServer::Impl {
     publish_next();
   }
 
+  /// SIGUSR1 (ddswarm-launch: its discovery server dropped this participant's
+  /// endpoints, so no agent will ever match them): leave DDS and start again
+  /// as a new server, but only before any mission command came.
+  bool rejoin_now() {
+    if (!take_rejoin_request()) return false;
+    std::lock_guard<std::mutex> lock(mu);
+    if (!seen_missions.empty()) {
+      spdlog::warn("asked to join DDS again (SIGUSR1), but a mission has begun: staying");
+      return false;
+    }
+    spdlog::warn("asked to join DDS again (SIGUSR1: the discovery server dropped this participant's "
+                 "endpoints); starting again as a new server");
+    rejoin = true;
+    return true;
+  }
+
   void run_realtime(double deadline_wall) {
     state_text = "running";
     publish_tick();
@@ -731,7 +748,7 @@ struct SimServer::Impl {
     const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
     const auto grace = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(period_s * cfg.sim.realtime_grace));
-    while (!stop_requested() && wall_seconds() < deadline_wall) {
+    while (!stop_requested() && !rejoin_now() && wall_seconds() < deadline_wall) {
       next += period;
       auto now = Clock::now();
       if (next < now - 10 * period) {
@@ -764,7 +781,7 @@ struct SimServer::Impl {
     publish_tick();
     double last_republish = wall_seconds();
     bool ahead = false;  // pipelined: the world has stepped past the published tick
-    while (!stop_requested() && wall_seconds() < deadline_wall) {
+    while (!stop_requested() && !rejoin_now() && wall_seconds() < deadline_wall) {
       // Pipelined: step now, while the agents compute their answers to the
       // published tick; those answers fly the step after this one.
       if (pipelined && !ahead) {
@@ -804,7 +821,7 @@ struct SimServer::Impl {
     }
   }
 
-  void run(double duration_s) {
+  SimServer::End run(double duration_s) {
     start_wall = wall_seconds();
     rtf_wall = start_wall;
     double deadline = duration_s > 0 ? start_wall + duration_s : 1e300;
@@ -819,11 +836,12 @@ struct SimServer::Impl {
     state_text = "stopping";
     publish_status(true);
     spdlog::info("ddswarm-sim: stopped at tick {} (sim {:.2f} s)", tick, sim_time());
+    return rejoin ? SimServer::End::kRejoinRequested : SimServer::End::kStopped;
   }
 };
 
 SimServer::SimServer(ServerConfig cfg) : impl_(std::make_unique<Impl>(std::move(cfg))) {}
 SimServer::~SimServer() = default;
-void SimServer::run(double duration_s) { impl_->run(duration_s); }
+SimServer::End SimServer::run(double duration_s) { return impl_->run(duration_s); }
 
 }  // namespace ddswarm::sim

@@ -34,8 +34,12 @@ class SimServer {
   /// Builds the world and joins DDS; throws on failure (message names what failed).
   explicit SimServer(ServerConfig cfg);
   ~SimServer();
-  /// Runs until stop_requested() or duration_s of wall time (<= 0: forever).
-  void run(double duration_s);
+  enum class End { kStopped, kRejoinRequested };
+  /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
+  /// kStopped. kRejoinRequested on take_rejoin_request() (SIGUSR1) before any
+  /// mission command came: the caller should destroy this server and start a
+  /// new one (a new world, which before a mission loses nothing).
+  End run(double duration_s);
 
  private:
   struct Impl;

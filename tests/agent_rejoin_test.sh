@@ -18,6 +18,14 @@ start sim "$BIN/ddswarm-sim" --scenario "$scenario" --domain "$DOMAIN"
 for _ in $(seq "$(slow 200)"); do grep -q "scene 'thesis_course' received" "$WORK/agent.log" && break; sleep 0.1; done
 grep -q "scene 'thesis_course' received" "$WORK/agent.log" || fail "the re-joined agent never received the scene"
 n=$(grep -c "joining again" "$WORK/agent.log")
+# SIGUSR1 to the server before any mission (what ddswarm-launch sends when its
+# discovery server dropped the server's endpoints): it starts again as a new
+# server, and the agent follows it.
+kill -USR1 "$PID_sim"
+for _ in $(seq "$(slow 100)"); do grep -q "starting again as a new server" "$WORK/sim.log" && break; sleep 0.1; done
+grep -q "starting again as a new server" "$WORK/sim.log" || fail "SIGUSR1 did not make the server start again"
+for _ in $(seq "$(slow 200)"); do grep -q "new server instance" "$WORK/agent.log" && break; sleep 0.1; done
+grep -q "new server instance" "$WORK/agent.log" || fail "the agent never heard the new server"
 timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" wait-agents --count 1 --timeout 30 || fail "the re-joined agent is not online"
 timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" takeoff --wait || fail "the re-joined agent's drone did not take off"
 [ "$(grep -c "joining again" "$WORK/agent.log")" -eq "$n" ] || fail "the agent kept re-joining after it had the scene"
@@ -34,4 +42,9 @@ for _ in $(seq "$(slow 200)"); do [ "$(grep -c "scene 'thesis_course' received" 
 [ "$(grep -c "scene 'thesis_course' received" "$WORK/agent.log")" -ge 2 ] || fail "the agent did not get the scene after joining again"
 timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" land --wait || fail "the drone did not land after its agent joined again"
 echo "joined again on SIGUSR1, then landed"
+# Once a mission has begun, a new server would be a new world: it stays.
+kill -USR1 "$PID_sim"
+for _ in $(seq "$(slow 100)"); do grep -q "a mission has begun: staying" "$WORK/sim.log" && break; sleep 0.1; done
+grep -q "a mission has begun: staying" "$WORK/sim.log" || fail "the server did not refuse to start again mid-mission"
+[ "$(grep -c "starting again as a new server" "$WORK/sim.log")" -eq 1 ] || fail "the server started again mid-mission"
 echo PASS
