@@ -4,9 +4,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
@@ -24,6 +26,11 @@ using namespace ddswarm;
 using namespace ddswarm::gs;
 
 namespace {
+
+/// Through a discovery server: seconds without hearing the server after which
+/// a ground station joins again as a new participant (a healthy one hears it
+/// within 1-2 s, 6 s at a 128-process bring-up).
+constexpr double kRejoinAfterS = 10.0;
 
 int report(const CommandResult& r) {
   std::printf("%s\n", r.message.c_str());
@@ -202,12 +209,30 @@ int main(int argc, char** argv) {
       std::printf("%ld rows written to %s\n", t.rows(), trace_out.c_str());
       return 0;
     }
-    DdsCommander gs(file.gs, file.dds);
     const bool interactive = app.get_subcommands().empty() || *menu;
     // Give discovery a moment: the server's status is transient-local.
     // Status needs only the clock (a replayed recording has no server to command).
-    const bool ready = (*status || (*task && attach)) ? gs.wait_for_status(file.gs.discovery_timeout_s)
-                               : gs.wait_for_server(file.gs.discovery_timeout_s);
+    // Through a discovery server, a participant that hears no server within
+    // kRejoinAfterS joins again as a new one: under a 128-process bring-up
+    // Fast DDS 2.9's discovery server sometimes drops a participant's endpoints
+    // for good, and a ground station's as well as an agent's.
+    std::unique_ptr<DdsCommander> commander;
+    const bool via_discovery_server = file.dds.discovery == Discovery::kDiscoveryServer;
+    const double deadline = wall_seconds() + file.gs.discovery_timeout_s;
+    bool ready = false;
+    for (;;) {
+      commander.reset();
+      commander = std::make_unique<DdsCommander>(file.gs, file.dds);
+      const double left = std::max(0.0, deadline - wall_seconds());
+      const double slice = via_discovery_server ? std::min(left, kRejoinAfterS) : left;
+      ready = (*status || (*task && attach)) ? commander->wait_for_status(slice) : commander->wait_for_server(slice);
+      if (ready || stop_requested() || !via_discovery_server || deadline - wall_seconds() < 1.0) break;
+      std::fprintf(stderr,
+                   "ddswarm-gs: no server heard within %.0f s through the discovery server; joining again as a "
+                   "new participant\n",
+                   slice);
+    }
+    DdsCommander& gs = *commander;
     if (!ready && !interactive) {
       if (stop_requested()) return 1;  // interrupted while discovering: reported below
       std::fprintf(stderr, "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",

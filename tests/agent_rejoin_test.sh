@@ -47,4 +47,24 @@ kill -USR1 "$PID_sim"
 for _ in $(seq "$(slow 100)"); do grep -q "a mission has begun: staying" "$WORK/sim.log" && break; sleep 0.1; done
 grep -q "a mission has begun: staying" "$WORK/sim.log" || fail "the server did not refuse to start again mid-mission"
 [ "$(grep -c "starting again as a new server" "$WORK/sim.log")" -eq 1 ] || fail "the server started again mid-mission"
+
+# A ground station that hears no server through a discovery server within
+# 10 s joins again as a new participant, and keeps trying until its
+# discovery timeout (the discovery server may have dropped its endpoints).
+ds_scenario="$WORK/rejoin_ds.yaml"
+sed 's/^ground_station:$/ground_station:\n  discovery_timeout_s: 40.0/' "$scenario" >"$ds_scenario"
+grep -q "discovery_timeout_s: 40.0" "$ds_scenario" || fail "could not write the discovery-server scenario"
+ds_domain=$(( (DOMAIN + 1) % 60 + 20 ))
+port=$(( 20000 + RANDOM % 20000 ))
+start ds fast-discovery-server -i 0 -l 127.0.0.1 -p "$port" -x "$SRC/config/discovery_server.xml"
+start gs_early timeout 60 "$BIN/ddswarm-gs" --config "$ds_scenario" --domain "$ds_domain" \
+  --discovery-server "127.0.0.1:$port" wait-agents --count 1 --timeout 30
+for _ in $(seq "$(slow 150)"); do grep -q "joining again as a new participant" "$WORK/gs_early.log" && break; sleep 0.1; done
+grep -q "joining again as a new participant" "$WORK/gs_early.log" || fail "the ground station did not join again after 10 s without a server"
+start sim_ds "$BIN/ddswarm-sim" --scenario "$ds_scenario" --domain "$ds_domain" --discovery-server "127.0.0.1:$port"
+start agent_ds "$BIN/ddswarm-agent" --id 0 --config "$ds_scenario" --domain "$ds_domain" --discovery-server "127.0.0.1:$port"
+wait_pid "$PID_gs_early" 60; rc=$?
+cat "$WORK/gs_early.log"
+[ $rc -eq 0 ] || fail "the re-joined ground station exited $rc"
+grep -q "1/6 agents online" "$WORK/gs_early.log" || fail "the re-joined ground station did not see the agent"
 echo PASS
