@@ -119,8 +119,17 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
       return app.exit(e) == 0 ? 0 : 2;
     }
+    // Derives the run's scenario with overrides; every process then reads the same file.
+    auto derive = [&](const std::map<std::string, YAML::Node>& overrides, const std::string& why) {
+      YAML::Node derived = apply_overrides(YamlDocument::load_file(scenario).root(), overrides);
+      const std::string dir = log_dir.empty() ? std::filesystem::temp_directory_path().string() : log_dir;
+      std::filesystem::create_directories(dir);
+      const std::string path = dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
+      std::ofstream(path) << "# " << scenario << " with " << why << "\n" << YAML::Dump(derived) << "\n";
+      std::cerr << "ddswarm-launch: scenario with " << why << " written to " << path << "\n";
+      scenario = path;
+    };
     if (!sets.empty()) {
-      // Derive the run's scenario once; every process then reads the same file.
       std::map<std::string, YAML::Node> overrides;
       for (const auto& kv : sets) {
         auto eq = kv.find('=');
@@ -128,13 +137,7 @@ int main(int argc, char** argv) {
           throw FieldError("--set", kv, "must be key.path=value");
         overrides[kv.substr(0, eq)] = YAML::Load(kv.substr(eq + 1));
       }
-      YAML::Node derived = apply_overrides(YamlDocument::load_file(scenario).root(), overrides);
-      const std::string dir = log_dir.empty() ? std::filesystem::temp_directory_path().string() : log_dir;
-      std::filesystem::create_directories(dir);
-      const std::string path = dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
-      std::ofstream(path) << "# " << scenario << " with --set overrides\n" << YAML::Dump(derived) << "\n";
-      std::cerr << "ddswarm-launch: scenario with overrides written to " << path << "\n";
-      scenario = path;
+      derive(overrides, "--set overrides");
     }
     if (app.count("--participant-id"))
       throw FieldError("--participant-id", app.get_option("--participant-id")->as<std::string>(),
@@ -189,6 +192,14 @@ int main(int argc, char** argv) {
       const int port = free_udp_port();
       procs.start(discovery_server_spec(port));
       procs.rejoin_dropped_agents("discovery-server");
+      // A longer lease for the swarm's own participants, unless the scenario
+      // names one: under a 128-process bring-up the discovery server, short of
+      // CPU, drops datagrams, and at the default 3 s it let the server's lease
+      // lapse and lost it for good (docs/performance.md).
+      const YAML::Node root = YamlDocument::load_file(scenario).root();
+      if (!(root["dds"] && root["dds"]["lease_duration_s"]))
+        derive({{"dds.lease_duration_s", YAML::Node(kDiscoveryServerLeaseS)}},
+               fmt::format("dds.lease_duration_s: {} (a discovery server)", kDiscoveryServerLeaseS));
       const std::string address = "127.0.0.1:" + std::to_string(port);
       dds_args.push_back("--discovery-server");
       dds_args.push_back(address);
