@@ -66,6 +66,7 @@ DdsConfig dds_for(int domain, const std::string& server, int participant_id = -1
   if (!server.empty()) {
     c.discovery = Discovery::kDiscoveryServer;
     c.discovery_server = server;
+    c.lease_duration_s = kDiscoveryServerLeaseS;  // as ddswarm-launch gives a swarm with one
   }
   return c;
 }

@@ -30,6 +30,16 @@ int rtps_unicast_port(int domain_id, int participant_id);
 /// domain 0, 62 at domain 232). Fast DDS's automatic ids try only ~100.
 int max_participant_id(int domain_id);
 
+/// The participants' lease (dds.lease_duration_s) in a swarm for which
+/// ddswarm-launch starts a discovery server, unless its scenario names one,
+/// and in bench/dds_floor's discovery-server runs. At the default 3 s, 2 of
+/// about 20 launches of 128 agent processes lost the server for good
+/// ("Matching unexisting participant from writer <server>"); at 20 s, none
+/// of 16. A crashed process stays matched in DDS that much longer; ddswarm's
+/// own timeouts (sim.agent_timeout_s, agent.server_timeout_s) do not depend
+/// on it.
+constexpr double kDiscoveryServerLeaseS = 20.0;
+
 struct DdsConfig {
   int domain_id = 0;                  ///< DDS domain, [0, 232]
   Discovery discovery = Discovery::kLocalhost;

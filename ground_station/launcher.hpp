@@ -104,15 +104,6 @@ struct DiscoveryServerChoice {
 /// Parses auto | on | off | IP:PORT; throws std::invalid_argument naming the text.
 DiscoveryServerChoice parse_discovery_server(const std::string& text);
 
-/// The participants' lease (dds.lease_duration_s) in a swarm for which the
-/// launcher starts a discovery server, unless its scenario names one. At the
-/// default 3 s, 2 of about 20 launches of 128 agent processes lost the
-/// server for good ("Matching unexisting participant from writer <server>");
-/// at 20 s, none of 8. A crashed process stays matched in DDS that much longer;
-/// ddswarm's own timeouts (sim.agent_timeout_s, agent.server_timeout_s) do not
-/// depend on it.
-constexpr double kDiscoveryServerLeaseS = 20.0;
-
 /// With auto, swarms of more than this many drones get a local discovery
 /// server: simple discovery is O(N^2) and above ~32 processes the server
 /// discovers faster and idles cheaper (docs/performance.md, bench/dds_floor).
