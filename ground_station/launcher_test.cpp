@@ -36,11 +36,14 @@ TEST(Launcher, ReportsWhichChildDiedAndWhy) {
 }
 
 TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
-  // As fast-discovery-server 2.9 prints it, colours and all.
-  const std::string line =
-      "\x1b[37;1m2026-11-21 21:17:38.547 \x1b[31;1m[\x1b[37;1mDISCOVERY_DATABASE\x1b[31;1m Error] \x1b[37mWriter "
-      "01.0f.78.fd.33.40.d6.23.25.00.00.00|0.0.1.2 has no associated participant. Skipping\x1b[34;1m -> Function "
-      "\x1b[36mcreate_writers_from_change_\x1b[m";
+  // As fast-discovery-server 2.9 prints its errors, colours and all.
+  auto logged = [](const std::string& message, const std::string& function) {
+    return "\x1b[37;1m2026-11-21 21:17:38.547 \x1b[31;1m[\x1b[37;1mDISCOVERY_DATABASE\x1b[31;1m Error] \x1b[37m" +
+           message + "\x1b[34;1m -> Function \x1b[36m" + function + "\x1b[m";
+  };
+  const std::string line = logged(
+      "Writer 01.0f.78.fd.33.40.d6.23.25.00.00.00|0.0.1.2 has no associated participant. Skipping",
+      "create_writers_from_change_");
   auto p = dropped_participant_prefix(line);
   ASSERT_TRUE(p);
   const std::array<std::uint8_t, 12> want = {0x01, 0x0f, 0x78, 0xfd, 0x33, 0x40, 0xd6, 0x23, 0x25, 0, 0, 0};
@@ -49,10 +52,8 @@ TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
   EXPECT_FALSE(dropped_participant_prefix("Attempting to delete and orphan reader -> Function delete_reader_entity_"));
   EXPECT_FALSE(dropped_participant_prefix("### Server is running ###"));
   EXPECT_FALSE(dropped_participant_prefix("Writer 01.0f.zz|0.0.1.2 has no associated participant. Skipping"));
-  const std::string unmatched =
-      "\x1b[37;1m2026-11-21 21:23:27.666 \x1b[31;1m[\x1b[37;1mDISCOVERY_DATABASE\x1b[31;1m Error] \x1b[37mMatching "
-      "unexisting participant from writer 01.0f.78.fd.b5.74.d4.24.00.00.00.00|0.0.1.3\x1b[34;1m -> Function "
-      "\x1b[36mmatch_writer_reader_\x1b[m";
+  const std::string unmatched = logged(
+      "Matching unexisting participant from writer 01.0f.78.fd.b5.74.d4.24.00.00.00.00|0.0.1.3", "match_writer_reader_");
   auto u = unmatched_participant_prefix(unmatched);
   ASSERT_TRUE(u);
   EXPECT_EQ(prefix_pid16(*u), 0x74b5);
