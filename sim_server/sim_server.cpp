@@ -126,6 +126,7 @@ struct SimServer::Impl {
   std::vector<msg::Beacon> pending_beacons;  // carried by accepted commands, forwarded next tick
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
   bool rejoin = false;  // run() ended on a rejoin request (rejoin_now)
+  bool swarm_silent = false;  // expire_agents: no live agent heard within agent_timeout_s
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   // What a ground station waits for changed since the last SimStatus: an
@@ -351,12 +352,24 @@ struct SimServer::Impl {
 
   // ---- main loop ----
 
-  /// Marks agents silent for longer than agent_timeout_s as lost. Call with mu held.
+  /// Marks agents silent for longer than agent_silence_limit as lost (in
+  /// mp_fault_agent_kill a server stall once made the five agents still
+  /// flying all lost at once). Call with mu held.
   void expire_agents() {
-    double now = wall_seconds();
+    const double now = wall_seconds();
+    double newest = -1e9;
+    for (const auto& s : slots)
+      if (s.live) newest = std::max(newest, s.last_heard_wall);
+    const double timeout = agent_silence_limit(now, newest, cfg.sim.agent_timeout_s);
+    const bool all_silent = newest > -1e9 && timeout > cfg.sim.agent_timeout_s;
+    if (all_silent && !swarm_silent)
+      spdlog::warn("no agent heard for {:.1f} s: waiting up to {:.1f} s before declaring any lost "
+                   "(the silence may be this server's)",
+                   now - newest, timeout);
+    swarm_silent = all_silent;
     for (int i = 0; i < n; ++i) {
       Slot& s = slots[i];
-      if (s.live && now - s.last_heard_wall > cfg.sim.agent_timeout_s) {
+      if (s.live && now - s.last_heard_wall > timeout) {
         s.live = false;
         s.owner = 0;
         if (!s.answered) --unanswered;
