@@ -113,8 +113,6 @@ struct DdsCommander::Impl {
     });
   }
 
-  /// Agents heard recently, plus those the server (the authority on
-  /// liveness) reports live in its latest status.
   /// The server is heard and count agents are online (count < 0: every drone).
   bool online_at_least(int count) const {
     if (!sim) return false;
@@ -122,6 +120,8 @@ struct DdsCommander::Impl {
     return online_locked().size() >= static_cast<std::size_t>(want);
   }
 
+  /// Agents heard recently, plus those the server (the authority on
+  /// liveness) reports live in its latest status.
   std::set<int> online_locked() const {
     std::set<int> out;
     double now = wall_seconds();
