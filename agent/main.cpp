@@ -67,14 +67,11 @@ int main(int argc, char** argv) {
     ddswarm::install_rejoin_signal();
     try {
       using ddswarm::agent::AgentApp;
-      const double end = duration_s > 0 ? ddswarm::wall_seconds() + duration_s : 0;
       // A new participant each time no scene came (agent.rejoin_after_s) or SIGUSR1 asked for one.
-      while (!ddswarm::stop_requested()) {
-        const double left = end > 0 ? end - ddswarm::wall_seconds() : 0;
-        if (end > 0 && left <= 0) break;
+      ddswarm::keep_joining(duration_s, [&](double left) {
         AgentApp agent(cfg);
-        if (agent.run(left) == AgentApp::End::kStopped) break;
-      }
+        return agent.run(left) != AgentApp::End::kStopped;
+      });
     } catch (const ddswarm::agent::DuplicateAgent& e) {
       std::fprintf(stderr, "ddswarm-agent: error: %s\n", e.what());
       return 3;

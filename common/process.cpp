@@ -33,6 +33,15 @@ void install_rejoin_signal() {
 
 bool take_rejoin_request() { return g_rejoin.exchange(false); }
 
+void keep_joining(double duration_s, const std::function<bool(double left_s)>& join) {
+  const double end = duration_s > 0 ? wall_seconds() + duration_s : 0;
+  while (!stop_requested()) {
+    const double left = end > 0 ? end - wall_seconds() : 0;
+    if (end > 0 && left <= 0) return;
+    if (!join(left)) return;
+  }
+}
+
 void install_stop_signals() {
   struct sigaction sa {};
   sa.sa_handler = on_signal;

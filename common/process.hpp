@@ -22,6 +22,12 @@ void install_rejoin_signal();
 /// True once per SIGUSR1 received since the last call.
 bool take_rejoin_request();
 
+/// One DDS participant's life after another: join(left_s) runs one, given the
+/// wall seconds left of duration_s (0 when duration_s <= 0: no limit), and
+/// returns true to leave and join again as a new participant. Ends when it
+/// returns false, a stop is requested or duration_s (> 0) has passed.
+void keep_joining(double duration_s, const std::function<bool(double left_s)>& join);
+
 /// Runs body; maps ConfigError/CLI errors to exit 2, other exceptions to exit 1,
 /// printing "<prog>: error: <what>" on one line.
 int run_main(const char* prog, const std::function<int()>& body);

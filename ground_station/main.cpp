@@ -218,20 +218,20 @@ int main(int argc, char** argv) {
     // for good, and a ground station's as well as an agent's.
     std::unique_ptr<DdsCommander> commander;
     const bool via_discovery_server = file.dds.discovery == Discovery::kDiscoveryServer;
-    const double deadline = wall_seconds() + file.gs.discovery_timeout_s;
     bool ready = false;
-    for (;;) {
-      commander.reset();
+    keep_joining(file.gs.discovery_timeout_s, [&](double left) {
+      commander.reset();  // the old participant leaves before the new one joins
       commander = std::make_unique<DdsCommander>(file.gs, file.dds);
-      const double left = std::max(0.0, deadline - wall_seconds());
       const double slice = via_discovery_server ? std::min(left, kRejoinAfterS) : left;
       ready = (*status || (*task && attach)) ? commander->wait_for_status(slice) : commander->wait_for_server(slice);
-      if (ready || stop_requested() || !via_discovery_server || deadline - wall_seconds() < 1.0) break;
+      if (ready || stop_requested() || !via_discovery_server || left - slice < 1.0) return false;
       std::fprintf(stderr,
                    "ddswarm-gs: no server heard within %.0f s through the discovery server; joining again as a "
                    "new participant\n",
                    slice);
-    }
+      return true;
+    });
+    if (!commander) commander = std::make_unique<DdsCommander>(file.gs, file.dds);  // stopped before joining
     DdsCommander& gs = *commander;
     if (!ready && !interactive) {
       if (stop_requested()) return 1;  // interrupted while discovering: reported below

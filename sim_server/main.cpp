@@ -45,13 +45,11 @@ int main(int argc, char** argv) {
       spdlog::info("removed {} shared-memory files ({:.1f} MB) left by crashed processes",
                    r.files_removed, r.bytes_freed / 1e6);
     ddswarm::install_rejoin_signal();
-    const double end = duration_s > 0 ? ddswarm::wall_seconds() + duration_s : 0;
-    while (!ddswarm::stop_requested()) {  // a new server each time SIGUSR1 asks before a mission (SimServer::run)
-      const double left = end > 0 ? end - ddswarm::wall_seconds() : 0;
-      if (end > 0 && left <= 0) break;
+    // A new server each time SIGUSR1 asks before a mission (SimServer::run).
+    ddswarm::keep_joining(duration_s, [&](double left) {
       ddswarm::sim::SimServer server(cfg);
-      if (server.run(left) != ddswarm::sim::SimServer::End::kRejoinRequested) break;
-    }
+      return server.run(left) == ddswarm::sim::SimServer::End::kRejoinRequested;
+    });
     return 0;
   });
 }
