@@ -191,7 +191,7 @@ int main(int argc, char** argv) {
       // First, so every participant finds it; clients retry until it answers.
       const int port = free_udp_port();
       procs.start(discovery_server_spec(port));
-      procs.rejoin_dropped_agents("discovery-server");
+      procs.rejoin_dropped_participants("discovery-server");
       // A longer lease for the swarm's own participants, unless the scenario
       // names one: under a 128-process bring-up the discovery server, short of
       // CPU, drops datagrams, and at the default 3 s it let the server's lease

@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cstdlib>
@@ -105,38 +106,30 @@ pid_t Launcher::start(const ChildSpec& spec) {
   return pid;
 }
 
-void Launcher::rejoin_dropped_agents(const std::string& ds_name) {
+void Launcher::rejoin_dropped_participants(const std::string& ds_name) {
   std::lock_guard<std::mutex> lock(mu_);
   drop_watch_ = ds_name;
 }
 
 void Launcher::on_dropped(const std::array<std::uint8_t, 12>& prefix, bool server_only) {
-  if (server_only) {
-    bool server = false;
-    for (const auto& [pid, c] : live_) server |= (pid & 0xffff) == prefix_pid16(prefix) && c->name == "sim";
-    if (!server) return;
-  }
+  const int pid16 = prefix_pid16(prefix);
+  const auto it = std::find_if(live_.begin(), live_.end(), [&](const auto& kv) { return (kv.first & 0xffff) == pid16; });
+  const Child* c = it == live_.end() ? nullptr : it->second.get();
+  if (server_only && !(c && c->name == "sim")) return;
   if (!dropped_seen_.insert(prefix).second) return;  // one participant: several endpoint lines
   std::string guid;
   for (auto b : prefix) guid += fmt::format("{}{:02x}", guid.empty() ? "" : ".", b);
-  const int pid16 = prefix_pid16(prefix);
-  bool found = false;
-  for (const auto& [pid, c] : live_) {
-    if ((pid & 0xffff) != pid16) continue;
-    found = true;
-    if (c->name.rfind("agent", 0) == 0 || c->name == "sim") {
-      std::cerr << "ddswarm-launch: the discovery server dropped " << c->name << "'s endpoints (participant "
-                << guid << "); asking it to join again\n";
-      kill(pid, SIGUSR1);
-    } else {
-      std::cerr << "ddswarm-launch: warning: the discovery server dropped " << c->name
-                << "'s endpoints (participant " << guid
-                << "); Fast DDS 2.9 never matches them afterwards\n";
-    }
-  }
-  if (!found)  // a tool that joined by itself: it says so when it finds no server
+  if (!c) {  // a tool that joined by itself: it says so when it finds no server
     std::cerr << "ddswarm-launch: the discovery server dropped the endpoints of participant " << guid
               << ", not one of this launch's processes\n";
+  } else if (c->name.rfind("agent", 0) == 0 || c->name == "sim") {
+    std::cerr << "ddswarm-launch: the discovery server dropped " << c->name << "'s endpoints (participant " << guid
+              << "); asking it to join again\n";
+    kill(c->pid, SIGUSR1);
+  } else {
+    std::cerr << "ddswarm-launch: warning: the discovery server dropped " << c->name << "'s endpoints (participant "
+              << guid << "); Fast DDS 2.9 never matches them afterwards\n";
+  }
 }
 
 void Launcher::emit(Child& c, const char* data, std::size_t n, bool flush) {

@@ -53,10 +53,11 @@ class Launcher {
   /// Sends sig to one child by name (tests, fault injection).
   bool signal(const std::string& name, int sig);
   /// Reads child `ds_name`'s output as a Fast DDS discovery server's: when it
-  /// drops a participant's endpoints for good (dropped_participant_prefix),
-  /// the agent child whose process that participant is gets SIGUSR1 (join
-  /// again), once per participant, and the launcher says so on stderr.
-  void rejoin_dropped_agents(const std::string& ds_name);
+  /// drops a participant's endpoints for good (dropped_participant_prefix;
+  /// for the server also unmatched_participant_prefix), the agent or server
+  /// child whose process that participant is gets SIGUSR1 (join again), once
+  /// per participant, and the launcher says so on stderr.
+  void rejoin_dropped_participants(const std::string& ds_name);
 
   /// Directory of the running executable (where the sibling binaries live).
   static std::string self_dir();
@@ -74,7 +75,7 @@ class Launcher {
   /// mu_ held. server_only: act only when the participant is the server's.
   void on_dropped(const std::array<std::uint8_t, 12>& prefix, bool server_only);
 
-  std::string drop_watch_;                              ///< rejoin_dropped_agents
+  std::string drop_watch_;                              ///< rejoin_dropped_participants
   std::set<std::array<std::uint8_t, 12>> dropped_seen_;  ///< participants already acted on
 
   std::string log_dir_;

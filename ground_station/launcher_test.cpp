@@ -63,7 +63,7 @@ TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
 
 TEST(Launcher, AsksAnAgentWhoseEndpointsTheDiscoveryServerDroppedToJoinAgain) {
   Launcher l(::testing::TempDir() + "/launcher_drop_logs");
-  l.rejoin_dropped_agents("discovery-server");
+  l.rejoin_dropped_participants("discovery-server");
   // Children that exit with a code of their own on SIGUSR1.
   auto on_usr1 = [](int code) {
     return std::vector<std::string>{"/bin/sh", "-c",
