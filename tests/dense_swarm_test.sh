@@ -5,7 +5,9 @@
 # than 0.6 D_int apart. The same run with the thesis's sum over every peer
 # shows the scenario is dense enough to tell: its drones collide.
 source "$(dirname "$0")/lib.sh"
-fly() {  # fly K: takeoff, hold 30 s, status; prints "collisions min_pair_m"
+# fly K: takeoff, hold 30 s, status; sets COLL and MIN_PAIR. Runs in this shell
+# (never in $(...) or <(...)), so its fail ends the test with the logs.
+fly() {
   local k=$1 log="$WORK/k$1.log"
   timeout 200 "$BIN/ddswarm-launch" "$SRC/config/thesis_course.yaml" --drones 32 --mode lockstep \
     --domain "$DOMAIN" --log-dir "$WORK/logs-k$k" --set agent.activation.neighbours="$k" \
@@ -13,15 +15,13 @@ fly() {  # fly K: takeoff, hold 30 s, status; prints "collisions min_pair_m"
   local rc=$?
   [ $rc -eq 0 ] || { cat "$log"; tail -n 20 "$WORK"/logs-k"$k"/*.log; fail "neighbours $k: launch exited $rc"; }
   grep -q "32 airborne" "$log" || { cat "$log"; fail "neighbours $k: not all 32 drones airborne"; }
-  local c m
-  c=$(sed -n 's/.*| \([0-9]*\) collisions |.*/\1/p' "$log" | tail -1)
-  m=$(sed -n 's/^pairwise distance: min \([0-9.]*\) m, max .*/\1/p' "$log" | tail -1)
-  [ -n "$c" ] && [ -n "$m" ] || { cat "$log"; fail "neighbours $k: no collision count or pair distance in the status"; }
-  echo "$c $m"
+  COLL=$(sed -n 's/.*| \([0-9]*\) collisions |.*/\1/p' "$log" | tail -1)
+  MIN_PAIR=$(sed -n 's/^pairwise distance: min \([0-9.]*\) m, max .*/\1/p' "$log" | tail -1)
+  [ -n "$COLL" ] && [ -n "$MIN_PAIR" ] || { cat "$log"; fail "neighbours $k: no collision count or pair distance in the status"; }
 }
-read c6 m6 < <(fly 6)
+fly 6; c6=$COLL; m6=$MIN_PAIR
 echo "neighbours 6: $c6 collisions, closest pair $m6 m"
-read c0 m0 < <(fly 0)
+fly 0; c0=$COLL; m0=$MIN_PAIR
 echo "every peer (thesis): $c0 collisions, closest pair $m0 m"
 [ "$c6" -eq 0 ] || fail "neighbours 6: $c6 collisions"
 awk -v a="$m6" 'BEGIN{exit !(a > 2.4)}' || fail "neighbours 6: closest pair $m6 m, under 0.6 D_int (2.4 m)"

@@ -10,10 +10,13 @@ start launch "$BIN/ddswarm-launch" "$scenario" --mode realtime --domain "$DOMAIN
 gs wait-agents --count 4 --timeout 60 || fail "agents not online"
 gs takeoff --wait || fail "takeoff"
 gs hold --time 5 --wait || fail "hold"
-centroid() {  # prints "leader_y followers_mean_y"
-  gs status --drones | awk '$1 ~ /^[0-9]+$/ { if ($1 == 0) l = $3; else { s += $3; n++ } } END { printf "%.2f %.2f\n", l, s / n }'
+centroid() {  # sets LEADER_Y and FOLLOWERS_Y (their mean); runs in this shell, so fail ends the test
+  gs status --drones >"$WORK/status.txt" || fail "status --drones: $(cat "$WORK/status.txt")"
+  read -r LEADER_Y FOLLOWERS_Y < <(awk '$1 ~ /^[0-9]+$/ { if ($1 == 0) l = $3; else { s += $3; n++ } }
+    END { if (n > 0 && l != "") printf "%.2f %.2f\n", l, s / n }' "$WORK/status.txt")
+  [ -n "${FOLLOWERS_Y:-}" ] || fail "no drone rows in the status: $(cat "$WORK/status.txt")"
 }
-read l0 c0 < <(centroid)
+centroid; l0=$LEADER_Y; c0=$FOLLOWERS_Y
 gs follow --leader 0 || fail "follow"
 # Fly the leader north at 1 m/s for ~12 s, keeping the teleop link fresh.
 end=$((SECONDS + 12))
@@ -21,7 +24,7 @@ while [ $SECONDS -lt $end ]; do gs teleop --north 1.0 >/dev/null || fail "teleop
 # Stop the leader, and give the followers time to gather round it.
 gs teleop --north 0 >/dev/null || fail "teleop stop"
 sleep 8
-read l1 c1 < <(centroid)
+centroid; l1=$LEADER_Y; c1=$FOLLOWERS_Y
 echo "leader y $l0 -> $l1, followers' mean y $c0 -> $c1"
 awk -v a="$l0" -v b="$l1" 'BEGIN{exit !(b - a > 4.0)}' || fail "the leader did not fly north"
 # The followers came along and gathered round their leader: their mean is
