@@ -67,6 +67,8 @@ struct DdsCommander::Impl {
   Reader<msg::MissionAck>* ack_reader = nullptr;
   Reader<msg::TaskStatus>* task_reader = nullptr;
   std::optional<TaskOutcome> outcome;
+  Reader<msg::SwarmState>* state_reader = nullptr;  // made by the first swarm_snapshot()
+  std::optional<msg::SwarmState> state;             // the latest, once state_reader exists
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
   ~Impl() { dds.close(); }
@@ -535,6 +537,21 @@ SwarmStatus DdsCommander::status() {
   for (const auto& [id, a] : impl_->agents) phases[a.phase]++;
   for (const auto& [p, k] : phases) s.task_phase += fmt::format("{}{} {}", s.task_phase.empty() ? "" : ", ", k, to_string(p));
   return s;
+}
+
+std::optional<SwarmSnapshot> DdsCommander::swarm_snapshot(double timeout_s) {
+  Impl& m = *impl_;
+  if (!m.state_reader) {
+    m.state_reader = &m.dds.reader<msg::SwarmState>([&m](const msg::SwarmState& s, const fdds::SampleInfo&) {
+      std::lock_guard<std::mutex> lock(m.mu);
+      m.state = s;
+      m.cv.notify_all();
+    });
+  }
+  std::unique_lock<std::mutex> lock(m.mu);
+  m.cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return m.state.has_value(); });
+  if (!m.state) return std::nullopt;
+  return summarize(*m.state);
 }
 
 std::optional<TaskOutcome> DdsCommander::last_task() const {

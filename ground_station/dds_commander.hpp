@@ -9,6 +9,7 @@
 #include "common/dds_config.hpp"
 #include "ground_station/commander.hpp"
 #include "ground_station/gs_config.hpp"
+#include "ground_station/trace.hpp"
 
 namespace ddswarm::gs {
 
@@ -75,6 +76,10 @@ class DdsCommander final : public Commander {
   /// one. False on timeout (e.g. no task was ever run).
   bool wait_task_status(double timeout_s);
   SwarmStatus status() override;
+  /// Every drone as the next swarm state shows it (waits up to timeout_s);
+  /// nullopt if none came. Read on this ground station's own participant,
+  /// already matched with the server: no second join just to look.
+  std::optional<SwarmSnapshot> swarm_snapshot(double timeout_s);
 
   /// The last task's outcome, once wait_task() returned.
   std::optional<TaskOutcome> last_task() const;

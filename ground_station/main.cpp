@@ -263,9 +263,10 @@ int main(int argc, char** argv) {
       std::printf("%s\n%s\n", format_status(st).c_str(), format_rejections(st).c_str());
       if (const std::string c = format_commands(st); !c.empty()) std::printf("%s\n", c.c_str());
       if (status_drones) {
-        auto snap = snapshot(file.dds, 3.0);
+        auto snap = gs.swarm_snapshot(file.gs.discovery_timeout_s);
         if (!snap) {
-          std::fprintf(stderr, "ddswarm-gs: error: no swarm state received within 3 s\n");
+          std::fprintf(stderr, "ddswarm-gs: error: no swarm state received within %.0f s\n",
+                       file.gs.discovery_timeout_s);
           return 1;
         }
         std::printf("%s", snap->table().c_str());

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <atomic>
-#include <condition_variable>
 #include <limits>
 #include <cstring>
 #include <mutex>
@@ -61,27 +60,15 @@ std::string SwarmSnapshot::table() const {
   return out;
 }
 
-std::optional<SwarmSnapshot> snapshot(const DdsConfig& dds, double timeout_s) {
-  std::mutex mu;
-  std::condition_variable cv;
-  std::optional<msg::SwarmState> got;
-  Participant p(dds, "ddswarm-gs-status");
-  p.reader<msg::SwarmState>([&](const msg::SwarmState& s, const fdds::SampleInfo&) {
-    std::lock_guard<std::mutex> lock(mu);
-    if (!got) got = s;
-    cv.notify_all();
-  });
-  std::unique_lock<std::mutex> lock(mu);
-  cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return got.has_value(); });
-  if (!got) return std::nullopt;
+SwarmSnapshot summarize(const msg::SwarmState& s) {
   SwarmSnapshot snap;
-  snap.tick = got->tick();
-  snap.sim_time_s = got->sim_time_s();
+  snap.tick = s.tick();
+  snap.sim_time_s = s.sim_time_s();
   std::vector<Eigen::Vector3d> pos;
-  for (const auto& d : got->drones()) pos.push_back(from_msg(d.position()));
+  for (const auto& d : s.drones()) pos.push_back(from_msg(d.position()));
   snap.min_pair_m = pos.size() > 1 ? std::numeric_limits<double>::infinity() : 0;
   for (std::size_t i = 0; i < pos.size(); ++i) {
-    const auto& d = got->drones()[i];
+    const auto& d = s.drones()[i];
     DroneRow r;
     r.id = d.drone_id();
     r.x = pos[i].x();

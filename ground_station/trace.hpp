@@ -9,6 +9,10 @@
 
 #include "common/dds_config.hpp"
 
+namespace ddswarm::msg {
+class SwarmState;
+}
+
 namespace ddswarm::gs {
 
 class SwarmTrace {
@@ -43,7 +47,7 @@ struct SwarmSnapshot {
   std::string table() const;  ///< a per-drone table plus a summary line
 };
 
-/// Takes one SwarmState sample (waits up to timeout_s); nullopt if none came.
-std::optional<SwarmSnapshot> snapshot(const DdsConfig& dds, double timeout_s);
+/// The per-drone table and pairwise distances of one SwarmState sample.
+SwarmSnapshot summarize(const msg::SwarmState& s);
 
 }  // namespace ddswarm::gs
