@@ -115,6 +115,12 @@ class Participant {
     fdds::DataWriterQos q;  // a missing profile leaves w null
     if (pub->get_datawriter_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
       if (best_effort<T>()) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+      // Never a reliable VOLATILE writer, even from a user's profile file:
+      // Fast DDS 2.9.1 can deadlock one when a reader leaves (docs/dds.md).
+      // Readers keep their durability, so nothing they receive changes.
+      if (q.reliability().kind == fdds::RELIABLE_RELIABILITY_QOS &&
+          q.durability().kind == fdds::VOLATILE_DURABILITY_QOS)
+        q.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
       w = pub->create_datawriter(topic, q);
     }
     if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name + refused_hint(partition));
