@@ -1,6 +1,9 @@
 #include "common/participant.hpp"
 
+#include "common/shm_clean.hpp"
+
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
@@ -18,6 +21,8 @@ using eprosima::fastrtps::rtps::IPLocator;
 using eprosima::fastrtps::rtps::Locator_t;
 
 constexpr const char* kLoopback = "127.0.0.1";
+/// Participant ids 0..kInitialPeersRange-1 get unicast discovery pings.
+constexpr int kInitialPeersRange = 120;
 
 void load_profiles_once(const std::string& file) {
   static std::mutex mu;
@@ -26,6 +31,14 @@ void load_profiles_once(const std::string& file) {
   if (loaded == file) return;
   auto rc = fdds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file);
   if (rc != ReturnCode_t::RETCODE_OK) throw DdsError("cannot load DDS QoS profiles from " + file);
+  // Participants of one process talk through their transports, as those of
+  // two processes do, whatever the file says: with Fast DDS 2.9.1's
+  // intraprocess delivery, a participant that closed while another in its
+  // process lived on (the ground station's old status snapshot) left a
+  // dangling reader behind, and the process crashed on exit (docs/dds.md).
+  eprosima::fastrtps::LibrarySettingsAttributes lib = eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings();
+  lib.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(lib);
   loaded = file;
 }
 
@@ -52,6 +65,25 @@ void add_security(const DdsConfig& cfg, fdds::DomainParticipantQos& qos) {
   props.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", uri(f[2]));
   props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions", uri(f[3]));
   props.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
+
+/// Whether a participant for cfg adds the shared-memory transport.
+bool uses_shared_memory(const DdsConfig& cfg) {
+  // Not under DDS Security: over shared memory, Fast DDS 2.9's authentication
+  // handshakes left a server-agent pair unauthenticated for good in 3 of 10
+  // six-drone launches (0 of 18 over UDP on 127.0.0.1; docs/security.md).
+  //
+  // Not in the ThreadSanitizer build either: the transport's segments and
+  // ports are synchronised by robust mutexes and atomics shared between
+  // processes, which TSan cannot see, so it reported races inside Fast DDS's
+  // unsymbolized code on every few runs (docs/sanitizers.md). Over UDP every
+  // hand-off between threads is one TSan models, and our threads are the same.
+#ifdef DDSWARM_TSAN_BUILD
+  constexpr bool kShmAllowed = false;
+#else
+  constexpr bool kShmAllowed = true;
+#endif
+  return cfg.shared_memory && !cfg.secure() && kShmAllowed;
 }
 
 /// Builds participant QoS whose every transport is bound to what cfg allows.
@@ -113,23 +145,9 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
     }
   }
   // Give the initial-peers scan room for a large swarm on one host.
-  udp->maxInitialPeersRange = 120;
+  udp->maxInitialPeersRange = kInitialPeersRange;
 
-  // Not under DDS Security: over shared memory, Fast DDS 2.9's authentication
-  // handshakes left a server-agent pair unauthenticated for good in 3 of 10
-  // six-drone launches (0 of 18 over UDP on 127.0.0.1; docs/security.md).
-  //
-  // Not in the ThreadSanitizer build either: the transport's segments and
-  // ports are synchronised by robust mutexes and atomics shared between
-  // processes, which TSan cannot see, so it reported races inside Fast DDS's
-  // unsymbolized code on every few runs (docs/sanitizers.md). Over UDP every
-  // hand-off between threads is one TSan models, and our threads are the same.
-#ifdef DDSWARM_TSAN_BUILD
-  constexpr bool kShmAllowed = false;
-#else
-  constexpr bool kShmAllowed = true;
-#endif
-  if (cfg.shared_memory && !cfg.secure() && kShmAllowed) {
+  if (uses_shared_memory(cfg)) {
     auto shm = std::make_shared<SharedMemTransportDescriptor>();
     shm->segment_size(4 * 1024 * 1024);
     qos.transport().user_transports.push_back(shm);
@@ -182,7 +200,18 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     auto& pp = process_participants();
     std::lock_guard<std::mutex> lock(pp.mu);
     if (pp.first && !secure_) qos.wire_protocol().prefix = incarnation_prefix(*pp.first, pp.made);
+    // An automatic id whose shared-memory ports no process left behind: a
+    // server restarted after a SIGKILL came up on its dead predecessor's
+    // ports, and the agents kept sending into the old ones (shm_clean.hpp).
+    const bool clear_id = cfg.participant_id < 0 && uses_shared_memory(cfg);
+    if (clear_id)
+      qos.wire_protocol().participant_id = participant_id_clear_of_shm(
+          cfg.domain_id, std::min(kInitialPeersRange - 1, max_participant_id(cfg.domain_id)));
     participant_ = factory->create_participant(cfg.domain_id, qos);
+    if (!participant_ && clear_id && qos.wire_protocol().participant_id >= 0) {
+      qos.wire_protocol().participant_id = -1;  // e.g. the id is this process's already: Fast DDS picks
+      participant_ = factory->create_participant(cfg.domain_id, qos);
+    }
     if (participant_) {
       if (!pp.first) pp.first = participant_->guid().guidPrefix;
       ++pp.made;

@@ -1,5 +1,7 @@
 #include "common/shm_clean.hpp"
 
+#include "common/dds_config.hpp"
+
 #include <dirent.h>
 #include <fcntl.h>
 #include <sys/file.h>
@@ -107,6 +109,18 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
     }
   }
   return r;
+}
+
+int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir) {
+  auto held = [&](int port) {
+    struct stat st;
+    return stat((dir + "/fastrtps_port" + std::to_string(port)).c_str(), &st) == 0;
+  };
+  for (int id = 0; id <= max_id; ++id) {
+    const int meta = rtps_unicast_port(domain_id, id);
+    if (!held(meta) && !held(meta + 1)) return id;
+  }
+  return -1;
 }
 
 }  // namespace ddswarm

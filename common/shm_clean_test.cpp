@@ -1,5 +1,7 @@
 #include "common/shm_clean.hpp"
 
+#include "common/dds_config.hpp"
+
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/file.h>
@@ -96,4 +98,22 @@ TEST(ShmClean, KeepsADeadOwnersPortThatLiveSendersStillMap) {
   EXPECT_TRUE(d.has("fastrtps_port7413_el"));
   EXPECT_EQ(r.files_removed, 0);
   EXPECT_EQ(r.in_use, 1);
+}
+
+// A server restarted after a SIGKILL must not come up on its dead
+// predecessor's ports, which the agents still map and write into.
+TEST(ShmClean, ParticipantIdClearOfPortsADeadProcessLeft) {
+  using ddswarm::participant_id_clear_of_shm;
+  using ddswarm::rtps_unicast_port;
+  TempDir d;
+  const int domain = 42;
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path), 0);
+  // Id 0's metatraffic port (the dead server's), id 1's user-data port (a live agent's).
+  d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain, 0)));
+  d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain, 1) + 1));
+  // Another domain's ports and other files do not count.
+  d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain + 1, 2)));
+  d.touch("fastrtps_" + std::to_string(rtps_unicast_port(domain, 2)));
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path), 2);
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 1, d.path), -1);  // every id up to max_id is held
 }
