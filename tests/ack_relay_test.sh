@@ -2,8 +2,8 @@
 # Issue 8: a command is confirmed through the server when a ground station
 # never discovers an agent's ack and heartbeat writers (at 128 processes Fast
 # DDS 2.9 sometimes leaves such pairs unmatched). Agent 2 here offers both
-# with a durability the ground station's readers refuse (volatile against
-# transient-local), so DDS never matches them; the agent still gets the
+# with a reliability the ground station's readers refuse (best-effort against
+# reliable), so DDS never matches them; the agent still gets the
 # command through the server and applies it, and the seq it accepted and its
 # phase come back in SimStatus.mission_seq and SimStatus.phase, so
 # `takeoff --wait` sees its climb end too. Nor does a ground station hold its
@@ -13,10 +13,10 @@ source "$(dirname "$0")/lib.sh"
 scenario="$WORK/relay.yaml"
 sed -e 's/^  drones: 6$/  drones: 3/' -e 's/^  ack_timeout_s: 5.0$/  ack_timeout_s: 12.0/' "$SRC/config/thesis_course.yaml" >"$scenario"
 grep -q "^  drones: 3$" "$scenario" && grep -q "^  ack_timeout_s: 12.0$" "$scenario" || fail "could not write the test scenario"
-# The ack and heartbeat writer profiles, volatile instead of transient-local.
-awk '/<data_writer profile_name="(ack|heartbeat)">/ { w = 1 } w && /TRANSIENT_LOCAL/ { sub("TRANSIENT_LOCAL", "VOLATILE"); w = 0 } { print }' \
+# The ack and heartbeat writer profiles, best-effort instead of reliable.
+awk '/<data_writer profile_name="(ack|heartbeat)">/ { w = 1 } w && /RELIABLE/ { sub("RELIABLE", "BEST_EFFORT"); w = 0 } { print }' \
   "$SRC/config/dds_profiles.xml" >"$WORK/unmatched_acks.xml"
-[ "$(grep -c VOLATILE "$WORK/unmatched_acks.xml")" -eq $(( $(grep -c VOLATILE "$SRC/config/dds_profiles.xml") + 2 )) ] ||
+[ "$(grep -c BEST_EFFORT "$WORK/unmatched_acks.xml")" -eq $(( $(grep -c BEST_EFFORT "$SRC/config/dds_profiles.xml") + 2 )) ] ||
   fail "could not write the test profiles"
 start sim "$BIN/ddswarm-sim" --scenario "$scenario" --domain "$DOMAIN"
 start agent0 "$BIN/ddswarm-agent" --id 0 --config "$scenario" --domain "$DOMAIN"
