@@ -551,7 +551,7 @@ std::optional<SwarmSnapshot> DdsCommander::swarm_snapshot(double timeout_s) {
   std::unique_lock<std::mutex> lock(m.mu);
   m.cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return m.state.has_value(); });
   if (!m.state) return std::nullopt;
-  return summarize(*m.state);
+  return snapshot_of(*m.state);
 }
 
 std::optional<TaskOutcome> DdsCommander::last_task() const {

@@ -60,7 +60,7 @@ std::string SwarmSnapshot::table() const {
   return out;
 }
 
-SwarmSnapshot summarize(const msg::SwarmState& s) {
+SwarmSnapshot snapshot_of(const msg::SwarmState& s) {
   SwarmSnapshot snap;
   snap.tick = s.tick();
   snap.sim_time_s = s.sim_time_s();

@@ -48,6 +48,6 @@ struct SwarmSnapshot {
 };
 
 /// The per-drone table and pairwise distances of one SwarmState sample.
-SwarmSnapshot summarize(const msg::SwarmState& s);
+SwarmSnapshot snapshot_of(const msg::SwarmState& s);
 
 }  // namespace ddswarm::gs
