@@ -17,6 +17,7 @@
 #include "common/mission.hpp"
 #include "common/participant.hpp"
 #include "common/process.hpp"
+#include "sim_server/agent_liveness.hpp"
 #include "sim_server/command_gate.hpp"
 #include "sim_server/mission_ring.hpp"
 #include "sim_server/task_referee.hpp"
