@@ -10,9 +10,11 @@
 #                      Fast DDS 2.9 and dds.participant_id's range leave some unreachable)
 #   --rt-sizes "..."   real-time counts (default: the same)
 #   --time S           lockstep seconds measured per N (default 10)
-#   --lockstep "plain pipelined"   lockstep variants per N: plain (each command flies the
-#                      step right after its state) and pipelined (sim.lockstep_pipeline:
-#                      physics runs while agents answer; commands act one tick later)
+#   --lockstep "plain pipelined hosts"   lockstep variants per N: plain (each command flies the
+#                      step right after its state), pipelined (sim.lockstep_pipeline:
+#                      physics runs while agents answer; commands act one tick later) and
+#                      hosts (plain, the N drones' agents in --lockstep-hosts K agent-host
+#                      processes, default 2: the same laws, far fewer DDS round trips)
 #   --rt-time S        real-time seconds measured per N (default 60)
 #   --rt-streams best-effort|reliable   real time (per-drone processes and agent hosts): the state and command streams' QoS
 #                      (dds.best_effort_streams; default best-effort)
@@ -51,7 +53,8 @@ HOSTS_K=2
 HOSTS_PHYS=250
 HOSTS_SENS=10
 T1_JOBS=2
-LS_VARIANTS="plain pipelined"
+LS_VARIANTS="plain pipelined hosts"
+LS_HOSTS_K=2
 RT_STREAMS=best-effort
 RT_GRACE=0.6
 while [ $# -gt 0 ]; do
@@ -68,6 +71,7 @@ while [ $# -gt 0 ]; do
     --plot) PLOT="$2"; shift 2 ;;
     --set) SETS+=(--set "$2"); shift 2 ;;
     --dds-profiles) SETS+=(--set "dds.profiles_file=$(realpath "$2")"); PROFILE_ARGS+=(--dds-profiles "$(realpath "$2")"); shift 2 ;;
+    --lockstep-hosts) LS_HOSTS_K="$2"; shift 2 ;;
     --hosts-drones) HOSTS_N="$2"; shift 2 ;;
     --agent-hosts) HOSTS_K="$2"; shift 2 ;;
     --hosts-physics) HOSTS_PHYS="$2"; shift 2 ;;
@@ -207,7 +211,8 @@ if ! skip lockstep; then
       case "$v" in
         plain) RUN_EXTRA=(); RUN_TAG="" ;;
         pipelined) RUN_EXTRA=(--set sim.lockstep_pipeline=true); RUN_TAG="-pipelined" ;;
-        *) echo "swarm_bench: unknown lockstep variant '$v' (plain, pipelined)" >&2; exit 2 ;;
+        hosts) RUN_EXTRA=(--agent-hosts "$LS_HOSTS_K"); RUN_TAG="-lockstep-hosts" ;;
+        *) echo "swarm_bench: unknown lockstep variant '$v' (plain, pipelined, hosts)" >&2; exit 2 ;;
       esac
       echo "swarm_bench: lockstep N=$n, $v (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
       echo "variant=$v $(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
@@ -215,7 +220,7 @@ if ! skip lockstep; then
   done
   RUN_EXTRA=(); RUN_TAG=""
   echo
-  echo "== lockstep: ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes; ${LS_TIME} s measured while holding =="
+  echo "== lockstep: ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
   echo "| N | variant | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   while read -r l; do
@@ -296,18 +301,22 @@ fi
 # ---------------------------------------------------------------- plot
 if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   : >"$OUT/plot.dat"
-  # One row per N: plain, floor, pipelined (? where a variant was not run, or
-  # its run failed: a swarm that never took off measures nothing).
+  # One row per N: plain, floor, pipelined, hosts (? where a variant was not
+  # run, or its run failed: a swarm that never took off measures nothing).
   for n in $SIZES; do
-    t="?"; p="?"; f="?"
+    t="?"; p="?"; f="?"; h="?"
     while read -r l; do
       [ "$(field n "$l")" = "$n" ] || continue
       f=$(field floor "$l")
       [ -n "$(note_cell "$l")" ] && continue
-      case "$(field variant "$l")" in plain) t=$(field ticks_per_s "$l") ;; pipelined) p=$(field ticks_per_s "$l") ;; esac
+      case "$(field variant "$l")" in
+        plain) t=$(field ticks_per_s "$l") ;;
+        pipelined) p=$(field ticks_per_s "$l") ;;
+        hosts) h=$(field ticks_per_s "$l") ;;
+      esac
     done <"$OUT/lockstep.txt"
-    echo "$n ${t:-?} ${f:-?} ${p:-?}" | sed 's/nan/?/g' |
-      awk '{ for (i = 2; i <= 4; ++i) if ($i != "?") $i = $i / 50; print }' >>"$OUT/plot.dat"
+    echo "$n ${t:-?} ${f:-?} ${p:-?} ${h:-?}" | sed 's/nan/?/g' |
+      awk '{ for (i = 2; i <= 5; ++i) if ($i != "?") $i = $i / 50; print }' >>"$OUT/plot.dat"
   done
   : >"$OUT/plot_rt.dat"
   [ -f "$OUT/realtime.txt" ] && while read -r l; do
@@ -318,8 +327,8 @@ if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   gnuplot <<EOF
 set terminal pngcairo size 900,600 font ",11" noenhanced
 set output "$PLOT"
-set title "Real-time factor against swarm size (one process per drone, 2 cores)"
-set xlabel "drones (agent processes)"
+set title "Real-time factor against swarm size (2 cores; one process per drone unless said)"
+set xlabel "drones"
 set ylabel "real-time factor (sim s per wall s, 50 Hz control)"
 set logscale xy
 set datafile missing "?"
@@ -331,6 +340,7 @@ set yrange [0.03:150]
 plot "$OUT/plot.dat" using 1:3 with linespoints lw 2 title "bare Fast DDS floor (ticks/s / 50)", \
      "$OUT/plot.dat" using 1:2 with linespoints lw 2 title "ddswarm lockstep (ticks/s / 50)", \
      "$OUT/plot.dat" using 1:4 with linespoints lw 2 title "ddswarm lockstep, pipelined (ticks/s / 50)", \
+     "$OUT/plot.dat" using 1:5 with linespoints lw 2 title "ddswarm lockstep, $LS_HOSTS_K agent hosts (ticks/s / 50)", \
      "$OUT/plot_rt.dat" using 1:2 with linespoints lw 2 title "ddswarm real time (paced, target 1)", \
      "-" using 1:2 with points pt 7 ps 1.6 title "gym-pybullet-drones: 10 at about 2x", \
      "-" using 1:2 with points pt 5 ps 1.6 title "SwarmLab: 16 at about 1x", \

@@ -11,7 +11,7 @@ for title in "bare Fast DDS lockstep floor" "== lockstep:" "== real time:" "== T
 done
 # Each table has a row for N = 3 with a figure in it, and Table 1 its split.
 grep -Eq '^\| 3 \| simple \| [0-9]+ \|' "$out" || fail "floor row for N=3 missing or empty"
-for v in plain pipelined; do
+for v in plain pipelined hosts; do
   grep -Eq "^\\| 3 \\| $v \\| [0-9.]+ \\| [0-9.]+ \\|" "$out" || fail "lockstep $v row for N=3 missing or empty"
 done
 grep -Eq '^\| 3 \| [0-9.]+ \| [0-9]+ / [0-9]+ / [0-9]+ \|' "$out" || fail "real-time row for N=3 missing or empty"
