@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <condition_variable>
 #include <mutex>
 #include <optional>
 #include <random>
@@ -142,6 +143,16 @@ struct AgentApp::Impl {
   // This tick's swarm members (live agent, not in failsafe, finite position),
   // by id: converted once per sample for every brain in the process.
   std::vector<PeerObservation> roster;
+  // How the swarm state should be read, from the scene's mode: best-effort in
+  // real time (dds.best_effort_streams), reliably in lockstep. The run loop
+  // makes the reader (not a DDS callback: Fast DDS endpoints are created and
+  // deleted outside its threads) and is woken when this changes.
+  std::optional<Delivery> states_wanted;
+  std::condition_variable woke;
+
+  // The run loop's own: the swarm-state reader and how it reads.
+  Reader<msg::SwarmState>* states = nullptr;
+  Delivery states_delivery = Delivery::kProfile;
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
   ~Impl() { dds.close(); }
@@ -191,9 +202,27 @@ struct AgentApp::Impl {
     // the server's business (it keeps the first owner and counts impostors).
     dds.remove(probe);
     publish_status();
-    dds.reader<msg::SwarmState>([this](const msg::SwarmState& s, const fdds::SampleInfo& info) {
-      on_swarm(s, info.sample_identity.writer_guid().guidPrefix);
-    });
+  }
+
+  /// Makes the swarm-state reader once a scene says how to read (and again
+  /// when a new server's scene says otherwise). Call without mu held:
+  /// removing a reader waits for its running callback, which takes mu.
+  void sync_states_reader() {
+    std::optional<Delivery> want;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      want = states_wanted;
+    }
+    if (!want || (states && *want == states_delivery)) return;
+    if (states) dds.remove(*states);
+    states = &dds.reader<msg::SwarmState>(
+        [this](const msg::SwarmState& s, const fdds::SampleInfo& info) {
+          on_swarm(s, info.sample_identity.writer_guid().guidPrefix);
+        },
+        std::nullopt, *want);
+    states_delivery = *want;
+    spdlog::info("{}: reading the swarm state {}", label,
+                 *want == Delivery::kLatest ? "best-effort (real time)" : "reliably");
   }
 
   /// The participant that announces the scene is the server: swarm samples
@@ -218,6 +247,9 @@ struct AgentApp::Impl {
       have_tick = false;
     }
     server_instance = s.server_instance();
+    states_wanted = s.mode() == msg::MODE_REALTIME && cfg.dds.best_effort_streams ? Delivery::kLatest
+                                                                                   : Delivery::kProfile;
+    woke.notify_all();
     control_period_s = 1.0 / s.control_rate_hz();
     scene_control_rate_hz = s.control_rate_hz();
     scene_seed = s.seed();
@@ -476,9 +508,10 @@ struct AgentApp::Impl {
                      label);
         return AgentApp::End::kRejoinRequested;
       }
+      sync_states_reader();
       publish_status();
       {
-        std::lock_guard<std::mutex> lock(mu);
+        std::unique_lock<std::mutex> lock(mu);
         double silent = wall_seconds() - last_sample_wall;
         if (have_tick && !server_lost && silent > cfg.agent.server_timeout_s) {
           server_lost = true;
@@ -493,8 +526,11 @@ struct AgentApp::Impl {
                        label, patience);
           return AgentApp::End::kNoScene;
         }
+        // Woken at once when a scene asks for a (new) swarm-state reader.
+        woke.wait_for(lock, std::chrono::milliseconds(250), [&] {
+          return stop_requested() || (states_wanted && (!states || *states_wanted != states_delivery));
+        });
       }
-      wait_for_stop(std::chrono::milliseconds(250));
     }
     return AgentApp::End::kStopped;
   }

@@ -55,14 +55,14 @@ msg::SwarmState make_state(int n) {
 
 std::string g_profiles;  // --profiles: a QoS profiles file other than ddswarm's
 double g_work_us = 0;  // --work-us: the publisher's CPU between ticks, standing in for physics
-bool g_best_effort = false;  // --best-effort-streams: as dds.best_effort_streams
+bool g_best_effort = false;  // --best-effort-streams: read the two streams as a real-time swarm does
+Delivery stream_delivery() { return g_best_effort ? Delivery::kLatest : Delivery::kProfile; }
 
 DdsConfig dds_for(int domain, const std::string& server, int participant_id = -1) {
   DdsConfig c;
   if (!g_profiles.empty()) c.profiles_file = g_profiles;
   c.domain_id = domain;
   c.participant_id = participant_id;
-  c.best_effort_streams = g_best_effort;
   if (!server.empty()) {
     c.discovery = Discovery::kDiscoveryServer;
     c.discovery_server = server;
@@ -87,7 +87,7 @@ int respond(int id, int domain, const std::string& server, double duration_s, in
     cmd.sim_time_s(s.sim_time_s());
     cmd.velocity().x(id < static_cast<int>(s.drones().size()) ? -sx * 1e-6 : 0);
     w.write(cmd);
-  });
+  }, std::nullopt, stream_delivery());
   wait_for_stop(std::chrono::duration<double>(duration_s));
   p.close();
   return 0;
@@ -162,7 +162,7 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
       if (c.tick() != tick || c.drone_id() >= n || answered[c.drone_id()]) return;
       answered[c.drone_id()] = 1;
       if (++count == n) cv.notify_all();
-    });
+    }, std::nullopt, stream_delivery());
     // Discovery: every responder's reader and writer matched with ours.
     while (!stop_requested() && (w.matched() < n || rd.matched() < n) && wall_seconds() - t0 < discovery_timeout_s)
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -278,8 +278,8 @@ int main(int argc, char** argv) {
                    "(0: none, the floor)")
         ->check(CLI::NonNegativeNumber);
     app.add_flag("--best-effort-streams", g_best_effort,
-                 "swarm state and commands best-effort, as dds.best_effort_streams (a lost tick is "
-                 "re-published after 0.25 s)");
+                 "read the swarm state and the commands best-effort, as a real-time swarm does "
+                 "(dds.best_effort_streams; writers stay reliable; a lost tick is re-published after 0.25 s)");
     app.add_option("--csv", csv, "append one row per run to this CSV");
     app.add_option("--log-dir", log_dir, "responder and discovery-server logs (default: discarded)");
     app.add_flag("--explicit-ids", explicit_ids,

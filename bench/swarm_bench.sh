@@ -16,7 +16,8 @@
 #                      hosts (plain, the N drones' agents in --lockstep-hosts K agent-host
 #                      processes, default 2: the same laws, far fewer DDS round trips)
 #   --rt-time S        real-time seconds measured per N (default 60)
-#   --rt-streams best-effort|reliable   real time (per-drone processes and agent hosts): the state and command streams' QoS
+#   --rt-streams best-effort|reliable   real time (per-drone processes and agent hosts): how the server reads the
+#                      commands and the agents the state (writers stay reliable)
 #                      (dds.best_effort_streams; default best-effort)
 #   --rt-grace G       real time (both): sim.realtime_grace, the share of a period the server waits
 #                      for late answers (default 0.6; the shipped default is 0.25)

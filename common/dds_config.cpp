@@ -153,8 +153,8 @@ void add_dds_options(CLI::App& app, DdsConfig& c) {
   app.add_option("--participant-id", c.participant_id, "RTPS participant id (-1 automatic)")
       ->group("Networking (default: this machine only)");
   app.add_flag("--best-effort-streams", c.best_effort_streams,
-               "real time: swarm state and velocity commands best-effort (dds.best_effort_streams; "
-               "every process of the swarm must agree)")
+               "real time: the server reads commands and agents read the swarm state best-effort "
+               "(dds.best_effort_streams, default on; =false reads them reliably)")
       ->group("Networking (default: this machine only)");
   app.add_option("--secure", c.security_dir,
                  "DDS Security: authenticate, access-control and encrypt with the credentials in DIR "

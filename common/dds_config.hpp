@@ -51,12 +51,15 @@ struct DdsConfig {
                                       ///< (at most max_participant_id(domain_id): the RTPS ports must fit)
   double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement
   std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles
-  /// Real time only: the per-tick streams (swarm state out, velocity commands
-  /// back; profiles `state` and `command`) go best-effort, as a newer sample
-  /// supersedes a lost one. Every process of the swarm must agree (they read
-  /// it from the same scenario): a reliable reader never matches a
-  /// best-effort writer. The server refuses it in lockstep.
-  bool best_effort_streams = false;
+  /// Real time only: the swarm's own readers of the per-tick streams, the
+  /// server's of the velocity commands and each agent's of the swarm state,
+  /// read them best-effort: no acknowledgements, as a newer sample supersedes
+  /// a lost one. Writers keep their profile (reliable), so any reliable
+  /// reader (recorder, ground station, web view, a process with false) still
+  /// gets every sample, and processes need not agree. Lockstep reads both
+  /// streams reliably whatever this says: a tick waits for every state and
+  /// command. Tools ignore it.
+  bool best_effort_streams = true;
   /// --secure: a directory made by scripts/make-certs; empty = DDS Security off
   /// (docs/security.md). With it, the participant authenticates (PKI-DH), is
   /// access controlled (signed governance and permissions) and encrypts (AES-GCM).

@@ -185,7 +185,6 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   load_profiles_once(cfg.profiles_file);
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   secure_ = cfg.secure();
-  best_effort_streams_ = cfg.best_effort_streams;
   role_ = cfg.security_role;
   auto qos = make_qos(cfg, name);
   {

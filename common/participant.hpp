@@ -52,6 +52,13 @@ class Writer {
   fdds::DataWriter* w_;
 };
 
+/// How a reader receives its topic. kLatest reads it best-effort whatever
+/// its profile says: no acknowledgements, a lost sample is superseded by the
+/// next. Only for the per-tick streams (kPerTickStream), and only from a
+/// reliable writer's point of view: writers keep their profile, so every
+/// reliable reader of the same writer still gets every sample.
+enum class Delivery { kProfile, kLatest };
+
 /// Called from a Fast DDS thread for every valid sample.
 template <class T>
 using SampleHandler = std::function<void(const T&, const fdds::SampleInfo&)>;
@@ -114,7 +121,6 @@ class Participant {
     fdds::DataWriter* w = nullptr;
     fdds::DataWriterQos q;  // a missing profile leaves w null
     if (pub->get_datawriter_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
-      if (best_effort<T>()) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
       // Never a reliable VOLATILE writer, even from a user's profile file:
       // Fast DDS 2.9.1 can deadlock one when a reader leaves (docs/dds.md).
       // Readers keep their durability, so nothing they receive changes.
@@ -131,7 +137,10 @@ class Participant {
   /// partition may be a pattern ("drone/*"); by default a per-drone topic
   /// (kPerDronePartition) is read from every drone's partition when secure.
   template <class T>
-  Reader<T>& reader(SampleHandler<T> handler, std::optional<std::string> partition_opt = std::nullopt) {
+  Reader<T>& reader(SampleHandler<T> handler, std::optional<std::string> partition_opt = std::nullopt,
+                    Delivery delivery = Delivery::kProfile) {
+    if (delivery == Delivery::kLatest && !kPerTickStream<T>)
+      throw DdsError(std::string("only the per-tick streams may be read best-effort, not ") + Topic<T>::name);
     const std::string partition = partition_opt.value_or(secure_ && kPerDronePartition<T> ? "drone/*" : "");
     auto* topic = topic_for<T>();
     auto listener = std::make_unique<Reader<T>>(std::move(handler));
@@ -139,7 +148,7 @@ class Participant {
     fdds::DataReader* r = nullptr;
     fdds::DataReaderQos q;
     if (sub->get_datareader_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
-      if (best_effort<T>()) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+      if (delivery == Delivery::kLatest) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
       r = sub->create_datareader(topic, q, listener.get());
     }
     if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));
@@ -168,12 +177,6 @@ class Participant {
   fdds::Subscriber* subscriber_for(const std::string& partition);
   /// Under DDS Security, why creating an endpoint may fail; empty otherwise.
   std::string refused_hint(const std::string& partition) const;
-  /// dds.best_effort_streams: the per-tick streams lose their profile's RELIABLE.
-  template <class T>
-  bool best_effort() const {
-    return best_effort_streams_ && kPerTickStream<T>;
-  }
-
   template <class T>
   fdds::Topic* topic_for() {
     std::lock_guard<std::mutex> lock(mu_);
@@ -192,7 +195,6 @@ class Participant {
   fdds::DomainParticipant* participant_ = nullptr;
   bool closed_ = false;
   bool secure_ = false;
-  bool best_effort_streams_ = false;
   std::string role_;
   fdds::Publisher* publisher_ = nullptr;
   fdds::Subscriber* subscriber_ = nullptr;

@@ -1,8 +1,12 @@
 // A process that leaves DDS and joins again (an agent re-joining) must come
-// back as a new participant, not under the GUID it left with.
+// back as a new participant, not under the GUID it left with; and a
+// per-tick stream read best-effort by the swarm stays reliable for tools.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <thread>
 
 #include "common/participant.hpp"
 #include "common/process.hpp"
@@ -40,6 +44,60 @@ TEST(Participant, IncarnationPrefixKeepsHostAndProcess) {
   EXPECT_EQ(p.value[10], 0x02);
   EXPECT_EQ(p.value[11], 0x03);
   EXPECT_NE(incarnation_prefix(first, 1), incarnation_prefix(first, 2));
+}
+
+template <class Pred>
+bool within(double seconds, Pred done) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+// dds.best_effort_streams: a swarm's own reader may read a per-tick stream
+// best-effort while a tool's reader of the same writer stays reliable. The
+// writer keeps its profile, so both match it and the reliable one gets every
+// sample.
+TEST(Participant, ReliableWriterServesBestEffortAndReliableReaders) {
+  std::atomic<int> got_latest{0}, got_all{0};  // outlive the participants' callbacks
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant server(cfg, "participant_test writer");
+  Participant agent(cfg, "participant_test best-effort reader");
+  Participant recorder(cfg, "participant_test reliable reader");
+  auto w = server.writer<msg::SwarmState>();
+  auto& latest = agent.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_latest; },
+                                               std::nullopt, Delivery::kLatest);
+  auto& all = recorder.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_all; });
+  EXPECT_EQ(latest.raw()->get_qos().reliability().kind, fdds::BEST_EFFORT_RELIABILITY_QOS);
+  EXPECT_EQ(all.raw()->get_qos().reliability().kind, fdds::RELIABLE_RELIABILITY_QOS);
+  EXPECT_EQ(w.raw()->get_qos().reliability().kind, fdds::RELIABLE_RELIABILITY_QOS);
+  // Matched both ways: a reader drops what comes before it has matched the writer.
+  ASSERT_TRUE(within(10, [&] { return w.matched() == 2 && latest.matched() == 1 && all.matched() == 1; }))
+      << "the writer matched " << w.matched() << " of 2 readers";
+  msg::SwarmState s;
+  for (std::uint64_t k = 1; k <= 20; ++k) {
+    s.tick(k);
+    ASSERT_TRUE(w.write(s));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_TRUE(within(10, [&] { return got_all.load() == 20; })) << "the reliable reader got " << got_all.load();
+  EXPECT_TRUE(within(10, [&] { return got_latest.load() > 0; })) << "the best-effort reader got nothing";
+  server.close();
+  agent.close();
+  recorder.close();
+}
+
+TEST(Participant, OnlyPerTickStreamsMayBeReadBestEffort) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant p(cfg, "participant_test");
+  EXPECT_THROW(p.reader<msg::Scene>([](const msg::Scene&, const fdds::SampleInfo&) {}, std::nullopt, Delivery::kLatest),
+               DdsError);
+  EXPECT_NO_THROW(p.reader<msg::VelocityCommand>([](const msg::VelocityCommand&, const fdds::SampleInfo&) {},
+                                                 std::nullopt, Delivery::kLatest));
 }
 
 }  // namespace

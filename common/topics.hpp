@@ -80,8 +80,8 @@ template <>
 inline constexpr bool kPerDronePartition<msg::VelocityCommand> = true;
 
 /// The per-tick streams, state out and commands back: a newer sample
-/// supersedes a lost one, so dds.best_effort_streams may drop their
-/// reliability (real time only).
+/// supersedes a lost one, so in real time the swarm's own readers may read
+/// them best-effort (dds.best_effort_streams, Delivery::kLatest).
 template <class T>
 inline constexpr bool kPerTickStream = false;
 template <>

@@ -178,7 +178,9 @@ int main(int argc, char** argv) {
         dds_args.push_back(v);
       }
     }
-    if (app.count("--best-effort-streams")) dds_args.push_back("--best-effort-streams");
+    // Its value, not just the flag: --best-effort-streams=false must reach the children as false.
+    if (app.count("--best-effort-streams"))
+      dds_args.push_back(std::string("--best-effort-streams=") + (dds_cli.best_effort_streams ? "true" : "false"));
     const std::string bin = Launcher::self_dir();
     install_stop_signals();
     const bool stop_on_death = on_death == "stop";

@@ -38,11 +38,10 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
   EXPECT_EQ(error_for("sim:\n  realtime_grace: 1.5\n"), "2: sim.realtime_grace = 1.5: must be in [0, 0.9]");
   EXPECT_EQ(error_for("sim:\n  lockstep_pipeline: maybe\n"),
             "2: sim.lockstep_pipeline = maybe: must be true or false");
-  // Best-effort streams would let a lost state or command stall a lockstep tick.
-  EXPECT_EQ(error_for("scenario:\n  mode: lockstep\ndds:\n  best_effort_streams: true\n"),
-            "4: dds.best_effort_streams = true: needs scenario.mode: realtime (a lockstep tick waits for "
-            "every state and command)");
-  EXPECT_EQ(error_for("scenario:\n  mode: realtime\ndds:\n  best_effort_streams: true\n"), "");
+  // Lockstep reads its streams reliably whatever dds.best_effort_streams says.
+  EXPECT_EQ(error_for("scenario:\n  mode: lockstep\ndds:\n  best_effort_streams: true\n"), "");
+  EXPECT_EQ(error_for("dds:\n  best_effort_streams: sometimes\n"),
+            "2: dds.best_effort_streams = sometimes: must be true or false");
   EXPECT_EQ(error_for("sim:\n  colour: red\n"), "2: sim.colour: unknown key");
   EXPECT_EQ(error_for("wings: 2\n"), "1: wings: unknown section");
   EXPECT_EQ(error_for("sensors:\n  count: many\n"), "2: sensors.count = many: must be an integer");

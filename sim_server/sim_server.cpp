@@ -38,9 +38,6 @@ void ServerConfig::validate() const {
                      "must be <= the world's size (diagonal of scene.bounds_min..bounds_max, " +
                          to_text(world_m) + " m)");
   dds.validate();
-  if (dds.best_effort_streams && scenario.mode == TimeMode::kLockstep)
-    throw FieldError("dds.best_effort_streams", "true",
-                     "needs scenario.mode: realtime (a lockstep tick waits for every state and command)");
   (void)scene.start_positions(scenario.drones, scenario.seed);
 }
 
@@ -217,9 +214,16 @@ struct SimServer::Impl {
     counters.server_instance(instance);
     counters.mode(cfg.scenario.mode == TimeMode::kLockstep ? msg::MODE_LOCKSTEP : msg::MODE_REALTIME);
 
+    // Real time: a command that is lost is superseded one period later, so
+    // the server need not acknowledge each (dds.best_effort_streams). A
+    // lockstep tick waits for every command: reliable.
+    const Delivery commands = cfg.scenario.mode == TimeMode::kRealtime && cfg.dds.best_effort_streams
+                                  ? Delivery::kLatest
+                                  : Delivery::kProfile;
     if (!dds.secure()) {
       dds.reader<msg::VelocityCommand>(
-          [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); });
+          [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); }, std::nullopt,
+          commands);
     } else {
       // DDS Security: only agent-K may publish in partition drone/K, so one
       // reader per drone knows whose commands it hears; a command there for
@@ -231,7 +235,7 @@ struct SimServer::Impl {
               std::lock_guard<std::mutex> lock(mu);
               counters.rejected_impostor(counters.rejected_impostor() + 1);
             },
-            drone_partition(k));
+            drone_partition(k), commands);
     }
     dds.reader<msg::AgentStatus>(
         [this](const msg::AgentStatus& s, const fdds::SampleInfo&) { on_heartbeat(s); });

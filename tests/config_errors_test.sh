@@ -65,8 +65,8 @@ case_ "sim: negative sensor range" 'bad_sensor_range\.yaml:7:' 'sensors\.max_ran
 case_ "sim: sensor range beyond the world" 'bad_sensor_beyond_world\.yaml:10:' 'sensors\.max_range_m' '\b600\b' "world's size" -- \
   run_sim "$S/bad_sensor_beyond_world.yaml"
 # A file that is fine alone, made invalid by a command-line option: the error names the file too.
-case_ "sim: --best-effort-streams in lockstep" 'thesis_course\.yaml: ' 'dds\.best_effort_streams = true' 'scenario\.mode: realtime' -- \
-  bounded "$BIN/ddswarm-sim" --scenario "$SRC/config/thesis_course.yaml" --mode lockstep --best-effort-streams --domain "$DOMAIN" --duration 1
+case_ "sim: --drones beyond the limit" 'thesis_course\.yaml: ' 'scenario\.drones = 2000' '\[1, 1024\]' -- \
+  bounded "$BIN/ddswarm-sim" --scenario "$SRC/config/thesis_course.yaml" --drones 2000 --domain "$DOMAIN" --duration 1
 
 # The agent's own section and its drone id.
 case_ "agent: wrong type" 'bad_agent_wrong_type\.yaml:6:' 'agent\.inter_distance_m' 'far' -- run_agent "$S/bad_agent_wrong_type.yaml"
