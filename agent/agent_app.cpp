@@ -526,10 +526,14 @@ struct AgentApp::Impl {
                        label, patience);
           return AgentApp::End::kNoScene;
         }
-        // Woken at once when a scene asks for a (new) swarm-state reader.
-        woke.wait_for(lock, std::chrono::milliseconds(250), [&] {
+        // Woken at once when a scene asks for a (new) swarm-state reader; a
+        // stop (a signal cannot notify) is seen within 50 ms, as wait_for_stop does.
+        const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(250);
+        const auto due = [&] {
           return stop_requested() || (states_wanted && (!states || *states_wanted != states_delivery));
-        });
+        };
+        while (!due() && std::chrono::steady_clock::now() < until)
+          woke.wait_for(lock, std::chrono::milliseconds(50), due);
       }
     }
     return AgentApp::End::kStopped;
