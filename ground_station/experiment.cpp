@@ -185,7 +185,14 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
                                             opt.record_dir + "/" + p.tag + ".mcap"})});
       }
       procs.start({"sim", common_args({bin + "/ddswarm-sim", "--scenario", p.scenario_file})});
-      for (int i = 0; i < rec.drones; ++i)
+      std::vector<int> ids(rec.drones);
+      for (int i = 0; i < rec.drones; ++i) ids[i] = i;
+      const auto shares = agent_host_shares(ids, opt.agent_hosts);
+      for (std::size_t h = 0; h < shares.size(); ++h)
+        procs.start({"agent host " + std::to_string(h),
+                     common_args({bin + "/ddswarm-agent", "--ids", shares[h], "--config", p.scenario_file,
+                                  "--duplicate-probe", "0.2"})});
+      for (int i = 0; opt.agent_hosts == 0 && i < rec.drones; ++i)
         procs.start({"agent " + std::to_string(i),
                      common_args({bin + "/ddswarm-agent", "--id", std::to_string(i), "--config",
                                   p.scenario_file, "--duplicate-probe", "0.2"})});

@@ -246,13 +246,9 @@ int main(int argc, char** argv) {
       if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
     }
     // Agent hosts: K processes, each flying a contiguous share of the ids.
-    for (int h = 0; agent_hosts > 0 && h < agent_hosts && h < static_cast<int>(ids.size()); ++h) {
-      const std::size_t per = (ids.size() + agent_hosts - 1) / agent_hosts;
-      const std::size_t lo = h * per, hi = std::min(ids.size(), lo + per);
-      if (lo >= hi) break;
-      std::string share;
-      for (std::size_t k = lo; k < hi; ++k) share += (share.empty() ? "" : ",") + std::to_string(ids[k]);
-      std::vector<std::string> a = {bin + "/ddswarm-agent", "--ids", share, "--config", scenario, "--drones",
+    const auto shares = agent_host_shares(ids, agent_hosts);
+    for (std::size_t h = 0; h < shares.size(); ++h) {
+      std::vector<std::string> a = {bin + "/ddswarm-agent", "--ids", shares[h], "--config", scenario, "--drones",
                                     std::to_string(n)};
       a.insert(a.end(), dds_args.begin(), dds_args.end());
       procs.start({"agent host " + std::to_string(h), a});

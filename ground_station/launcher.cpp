@@ -303,6 +303,19 @@ int agent_participant_id(int drones, int drone_id) {
   return pid <= kMaxParticipantId ? pid : -1;
 }
 
+std::vector<std::string> agent_host_shares(const std::vector<int>& ids, int hosts) {
+  std::vector<std::string> shares;
+  if (hosts <= 0 || ids.empty()) return shares;
+  const std::size_t per = (ids.size() + hosts - 1) / hosts;
+  for (std::size_t lo = 0; lo < ids.size(); lo += per) {
+    std::string share;
+    for (std::size_t k = lo; k < std::min(ids.size(), lo + per); ++k)
+      share += (share.empty() ? "" : ",") + std::to_string(ids[k]);
+    shares.push_back(share);
+  }
+  return shares;
+}
+
 std::string ephemeral_port_warning(int domain, int first_id, int last_id, int lo, int hi) {
   const int low = rtps_unicast_port(domain, first_id), high = rtps_unicast_port(domain, last_id) + 1;
   if (first_id < 0 || last_id < first_id || high < lo || low > hi) return "";

@@ -127,6 +127,11 @@ constexpr int kMaxParticipantId = 1100;  ///< 1024 drones and then some; dds.par
 /// `drones`, or -1 for Fast DDS's automatic one.
 int agent_participant_id(int drones, int drone_id);
 
+/// Agent hosts: the ids split into at most `hosts` contiguous shares as equal
+/// as ceil(ids / hosts) makes them, each the `--ids` argument of one
+/// `ddswarm-agent` ("0,1,2"). Fewer shares when there are fewer ids than hosts.
+std::vector<std::string> agent_host_shares(const std::vector<int>& ids, int hosts);
+
 /// The RTPS unicast ports (metatraffic and user, 7400 + 250*domain + 10/11 +
 /// 2*id) of explicit participant ids [first_id, last_id] that fall inside the
 /// kernel's ephemeral port range [lo, hi] (/proc/sys/net/ipv4/ip_local_port_range).

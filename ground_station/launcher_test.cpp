@@ -123,6 +123,17 @@ TEST(Launcher, IdRanges) {
   EXPECT_THROW(parse_id_ranges("x", 10), std::invalid_argument);
 }
 
+TEST(Launcher, AgentHostSharesSplitTheIdsContiguously) {
+  using V = std::vector<std::string>;
+  EXPECT_EQ(agent_host_shares({0, 1, 2, 3, 4, 5}, 2), (V{"0,1,2", "3,4,5"}));
+  EXPECT_EQ(agent_host_shares({0, 1, 2, 3, 4}, 2), (V{"0,1,2", "3,4"}));
+  EXPECT_EQ(agent_host_shares({3, 4, 5, 7}, 3), (V{"3,4", "5,7"}));  // ceil(4/3) = 2 per host: two hosts
+  EXPECT_EQ(agent_host_shares({0, 1}, 5), (V{"0", "1"}));             // never an empty host
+  EXPECT_EQ(agent_host_shares({0, 1, 2}, 1), (V{"0,1,2"}));
+  EXPECT_TRUE(agent_host_shares({0, 1, 2}, 0).empty());               // 0: one process per drone
+  EXPECT_TRUE(agent_host_shares({}, 2).empty());
+}
+
 TEST(Launcher, MissingProgramIsAClearError) {
   Launcher l;
   try {

@@ -171,6 +171,11 @@ int main(int argc, char** argv) {
     int jobs = 1;
     experiment->add_option("--jobs", jobs, "runs at a time, each on its own DDS domain (--domain, --domain + 1, ...)")
         ->check(CLI::Range(1, 16));
+    int exp_agent_hosts = 0;
+    experiment->add_option("--agent-hosts", exp_agent_hosts,
+                           "each run's agents in K ddswarm-agent --ids processes instead of one per drone "
+                           "(the same lockstep results, faster for large swarms)")
+        ->check(CLI::Range(0, 1024));
 
     try {
       app.parse(argc, argv);
@@ -200,6 +205,7 @@ int main(int argc, char** argv) {
       opt.gs = file.gs;
       opt.record_dir = record_dir;
       opt.jobs = jobs;
+      opt.agent_hosts = exp_agent_hosts;
       return run_experiment(exp, opt, std::cout);
     }
 

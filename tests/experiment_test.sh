@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Issue 4: a short experiment (2 sets x 2 runs, real multi-process lockstep
 # runs) produces a CSV, a Markdown table and plot files with the right counts.
-# Issue 8: run two at a time (--jobs 2, each on its own domain), it gives the
-# very same results, and it says where the wall time went.
+# Issue 8: run two at a time (--jobs 2, each on its own domain), or with each
+# run's agents in two agent-host processes (--agent-hosts 2), it gives the very
+# same results, and it says where the wall time went.
 source "$(dirname "$0")/lib.sh"
 out="$WORK/results"
 out2="$WORK/results2"
@@ -28,4 +29,11 @@ timeout "$(slow 400)" "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/test
 tail -3 "$WORK/experiment2.log"
 results() { awk -F, 'NR > 1 { print $1, $2, $3, $9, $11, $13, $14, $15, $16 }' "$1" | sort; }
 diff <(results "$out/short.csv") <(results "$out2/short.csv") || fail "two at a time gave other results"
+# The drones' agents in two agent-host processes: the very same results too.
+out3="$WORK/results3"
+timeout "$(slow 400)" "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out3" \
+  --agent-hosts 2 >"$WORK/experiment3.log" 2>&1 || { cat "$WORK/experiment3.log"; fail "experiment --agent-hosts 2 failed"; }
+tail -3 "$WORK/experiment3.log"
+ls "$out3"/logs/*/ | grep -q "agent_host_1" || fail "no agent-host logs: were the agents one process per drone?"
+diff <(results "$out/short.csv") <(results "$out3/short.csv") || fail "agent hosts gave other results"
 echo PASS
