@@ -185,6 +185,7 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   load_profiles_once(cfg.profiles_file);
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   secure_ = cfg.secure();
+  shared_memory_ = uses_shared_memory(cfg);
   role_ = cfg.security_role;
   auto qos = make_qos(cfg, name);
   {

@@ -127,6 +127,7 @@ class Participant {
       if (q.reliability().kind == fdds::RELIABLE_RELIABILITY_QOS &&
           q.durability().kind == fdds::VOLATILE_DURABILITY_QOS)
         q.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
+      if (!shared_memory_) q.data_sharing().off();
       w = pub->create_datawriter(topic, q);
     }
     if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name + refused_hint(partition));
@@ -149,6 +150,7 @@ class Participant {
     fdds::DataReaderQos q;
     if (sub->get_datareader_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
       if (delivery == Delivery::kLatest) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+      if (!shared_memory_) q.data_sharing().off();
       r = sub->create_datareader(topic, q, listener.get());
     }
     if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));
@@ -171,6 +173,10 @@ class Participant {
   fdds::DomainParticipant* raw() const { return participant_; }
   /// True when DDS Security is on (DdsConfig::security_dir).
   bool secure() const { return secure_; }
+  /// True when this participant uses shared memory (the transport and
+  /// data-sharing delivery): dds.shared_memory, and neither DDS Security nor
+  /// the TSan build.
+  bool shared_memory() const { return shared_memory_; }
 
  private:
   fdds::Publisher* publisher_for(const std::string& partition);
@@ -195,6 +201,10 @@ class Participant {
   fdds::DomainParticipant* participant_ = nullptr;
   bool closed_ = false;
   bool secure_ = false;
+  // Whether this participant uses shared memory at all: without the transport
+  // (dds.shared_memory false, DDS Security, the TSan build) Fast DDS's
+  // data-sharing delivery, which also goes through /dev/shm, is off too.
+  bool shared_memory_ = false;
   std::string role_;
   fdds::Publisher* publisher_ = nullptr;
   fdds::Subscriber* subscriber_ = nullptr;

@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
 #include <thread>
 
 #include "common/participant.hpp"
@@ -98,6 +101,42 @@ TEST(Participant, OnlyPerTickStreamsMayBeReadBestEffort) {
                DdsError);
   EXPECT_NO_THROW(p.reader<msg::VelocityCommand>([](const msg::VelocityCommand&, const fdds::SampleInfo&) {},
                                                  std::nullopt, Delivery::kLatest));
+}
+
+
+// The whole-swarm state goes by data-sharing, a pool in /dev/shm, to readers
+// on the host; a participant told to keep off shared memory
+// (dds.shared_memory: false: a container without a shared /dev/shm, a test
+// that wants every sample on UDP) must make no such pool.
+std::size_t data_sharing_pools_of(const Participant& p) {
+  const auto& g = p.raw()->guid().guidPrefix;
+  std::string prefix;
+  for (int i = 0; i < 12; ++i) {
+    char b[4];
+    std::snprintf(b, sizeof b, i ? ".%02x" : "%02x", g.value[i]);
+    prefix += b;
+  }
+  std::size_t n = 0;
+  for (const auto& f : std::filesystem::directory_iterator("/dev/shm"))
+    if (f.path().filename().string().rfind("fast_datasharing_" + prefix, 0) == 0) ++n;
+  return n;
+}
+
+TEST(Participant, SwarmStateUsesSharedMemoryOnlyWhenAllowed) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.shared_memory = false;
+  Participant udp_only(cfg, "participant_test");
+  EXPECT_FALSE(udp_only.shared_memory());
+  udp_only.writer<msg::SwarmState>();
+  EXPECT_EQ(data_sharing_pools_of(udp_only), 0u);
+  udp_only.close();
+  cfg.shared_memory = true;
+  Participant local(cfg, "participant_test");
+  local.writer<msg::SwarmState>();
+  // One pool, for the swarm-state writer (the TSan build never uses shared memory).
+  EXPECT_EQ(data_sharing_pools_of(local), local.shared_memory() ? 1u : 0u);
+  local.close();
 }
 
 }  // namespace
