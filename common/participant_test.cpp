@@ -103,7 +103,6 @@ TEST(Participant, OnlyPerTickStreamsMayBeReadBestEffort) {
                                                  std::nullopt, Delivery::kLatest));
 }
 
-
 // The whole-swarm state goes by data-sharing, a pool in /dev/shm, to readers
 // on the host; a participant told to keep off shared memory
 // (dds.shared_memory: false: a container without a shared /dev/shm, a test

@@ -24,14 +24,14 @@ sleep 6  # 300 ticks: far more than the pool's 4 samples
 t1=$(sim_time); w1=$(date +%s.%N)
 status=$(gs status --drones 2>&1)
 echo "$status"
-[ -n "$t0" ] && [ -n "$t1" ] || { kill -CONT "$PID_agent3"; fail "no status from the server"; }
+[ -n "$t0" ] && [ -n "$t1" ] || fail "no status from the server"
 rtf=$(echo "($t1 - $t0) / ($w1 - $w0)" | bc -l)
 printf 'while agent 3 was stopped: sim %.2f -> %.2f s in %.2f s of wall time (x%.2f real time)\n' \
   "$t0" "$t1" "$(echo "$w1 - $w0" | bc -l)" "$rtf"
-echo "$rtf >= 0.8" | bc -l | grep -q 1 || { kill -CONT "$PID_agent3"; fail "the server slowed to x$rtf real time behind a stopped agent"; }
+echo "$rtf >= 0.8" | bc -l | grep -q 1 || fail "the server slowed to x$rtf real time behind a stopped agent"
 echo "$status" | awk '$1 ~ /^[0-5]$/ && $1 != 3 && (/failsafe/ || !/airborne/) { bad = 1; print "drone " $1 ": " $0 } END { exit bad }' ||
-  { kill -CONT "$PID_agent3"; fail "another drone suffered from the stopped agent"; }
-echo "$status" | awk '$1 == 3' | grep -q failsafe || { kill -CONT "$PID_agent3"; fail "drone 3 is not in failsafe while its agent is stopped"; }
+  fail "another drone suffered from the stopped agent"
+echo "$status" | awk '$1 == 3' | grep -q failsafe || fail "drone 3 is not in failsafe while its agent is stopped"
 
 kill -CONT "$PID_agent3"
 ok=0

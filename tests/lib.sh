@@ -25,7 +25,8 @@ print_logs() {
 cleanup() {
   local rc=$?
   for pid in "${PIDS[@]:-}"; do
-    [ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null
+    # SIGCONT too: a process a test stopped (SIGSTOP) gets its SIGTERM only once it runs.
+    [ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null && kill -CONT "$pid" 2>/dev/null
   done
   local deadline=$((SECONDS + 5))
   for pid in "${PIDS[@]:-}"; do
