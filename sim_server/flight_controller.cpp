@@ -19,10 +19,11 @@ Eigen::Quaterniond canonical(const Eigen::Quaterniond& q) {
 }
 
 /// Attitude with body z along z_world_des and heading yaw (PX4 bodyzToAttitude).
-Eigen::Quaterniond attitude_from_thrust(const Eigen::Vector3d& z_des, double yaw) {
-  const Eigen::Vector3d x_course(std::cos(yaw), std::sin(yaw), 0.0);
+/// cos_yaw, sin_yaw: of the heading yaw.
+Eigen::Quaterniond attitude_from_thrust(const Eigen::Vector3d& z_des, double cos_yaw, double sin_yaw) {
+  const Eigen::Vector3d x_course(cos_yaw, sin_yaw, 0.0);
   Eigen::Vector3d y_des = z_des.cross(x_course);
-  if (y_des.squaredNorm() < 1e-12) y_des = Eigen::Vector3d(-std::sin(yaw), std::cos(yaw), 0.0);
+  if (y_des.squaredNorm() < 1e-12) y_des = Eigen::Vector3d(-sin_yaw, cos_yaw, 0.0);
   y_des.normalize();
   const Eigen::Vector3d x_des = y_des.cross(z_des);
   Eigen::Matrix3d r;
@@ -82,7 +83,11 @@ void ControllerConfig::validate() const {
 }
 
 FlightController::FlightController(const QuadrotorParams& params, const ControllerConfig& config)
-    : params_(params), cfg_(config), mixer_(params), inertia_(params.inertia()) {}
+    : params_(params),
+      cfg_(config),
+      mixer_(params),
+      inertia_(params.inertia()),
+      tan_max_tilt_(std::tan(config.max_tilt_rad)) {}
 
 void FlightController::reset(double yaw_rad) {
   yaw_sp_ = wrap_pi(yaw_rad);
@@ -159,11 +164,18 @@ std::array<double, 4> FlightController::update(const RigidState& s, const Veloci
         params_.drag_linear_n_per_mps * v_b;
     f -= q * drag_b;
   }
-  const double f_h_max = f.z() * std::tan(cfg_.max_tilt_rad);
+  const double f_h_max = f.z() * tan_max_tilt_;
   const double f_h = f.head<2>().norm();
   if (f_h > f_h_max) f.head<2>() *= f_h_max / f_h;
   const Eigen::Vector3d z_des = f.normalized();
-  const Eigen::Quaterniond q_sp = attitude_from_thrust(z_des, yaw_sp_);
+  // The heading setpoint rarely changes (yaw is held): its sine and cosine
+  // are computed again only when it does.
+  if (!(yaw_sp_ == trig_yaw_)) {
+    trig_yaw_ = yaw_sp_;
+    cos_yaw_sp_ = std::cos(yaw_sp_);
+    sin_yaw_sp_ = std::sin(yaw_sp_);
+  }
+  const Eigen::Quaterniond q_sp = attitude_from_thrust(z_des, cos_yaw_sp_, sin_yaw_sp_);
   const Eigen::Vector3d z_body = q * Eigen::Vector3d::UnitZ();
   // Project on the current body z so a tilting vehicle does not sink or climb.
   const double thrust = std::max(0.0, f.dot(z_body));

@@ -17,6 +17,14 @@ Mixer::Mixer(const QuadrotorParams& p)
   mixing_ = allocation_.inverse();
   t_lo_ = k_f_ * omega_min_ * omega_min_;
   t_hi_ = k_f_ * omega_max_ * omega_max_;
+  // Quotients mix() needs at every call: computed here once, by the same
+  // operations on the same operands, so the results do not change by a bit.
+  t_floor_ = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 4; ++i) {
+    lo_over_c_[i] = t_lo_ / mixing_(i, 0);
+    hi_over_c_[i] = t_hi_ / mixing_(i, 0);
+    t_floor_ = std::max(t_floor_, lo_over_c_[i]);
+  }
 }
 
 MixerResult Mixer::mix(const Wrench& demand) const {
@@ -34,20 +42,19 @@ MixerResult Mixer::mix(const Wrench& demand) const {
 
   // Largest roll/pitch share s* for which some collective fits every rotor:
   // for all i, j: (lo - s a_i)/c_i <= (hi - s a_j)/c_j.
+  double a_over_c[4];
+  for (int i = 0; i < 4; ++i) a_over_c[i] = a[i] / c_t[i];
   double s_max = 1.0;
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) {
-      const double coef = a[j] / c_t[j] - a[i] / c_t[i];
-      if (coef > 0) s_max = std::min(s_max, (hi / c_t[j] - lo / c_t[i]) / coef);
+      const double coef = a_over_c[j] - a_over_c[i];
+      if (coef > 0) s_max = std::min(s_max, (hi_over_c_[j] - lo_over_c_[i]) / coef);
     }
   s_max = std::clamp(s_max, 0.0, 1.0);
 
-  double t_top = kInf;     // highest collective that fits at s*
-  double t_floor = -kInf;  // lowest collective any rotor setting allows
-  for (int i = 0; i < 4; ++i) {
-    t_top = std::min(t_top, (hi - s_max * a[i]) / c_t[i]);
-    t_floor = std::max(t_floor, lo / c_t[i]);
-  }
+  double t_top = kInf;                // highest collective that fits at s*
+  const double t_floor = t_floor_;    // lowest collective any rotor setting allows
+  for (int i = 0; i < 4; ++i) t_top = std::min(t_top, (hi - s_max * a[i]) / c_t[i]);
 
   double s = s_max;
   double thrust = demand.thrust_n;

@@ -43,6 +43,8 @@ class Mixer {
   Eigen::Matrix4d mixing_;
   double k_f_;
   double t_lo_, t_hi_;
+  double lo_over_c_[4], hi_over_c_[4];  ///< t_lo_, t_hi_ / mixing_(i, 0)
+  double t_floor_;                      ///< max_i lo_over_c_[i]
   double omega_min_, omega_max_;
 };
 
