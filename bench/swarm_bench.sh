@@ -22,6 +22,8 @@
 #   --rt-grace G       real time (both): sim.realtime_grace, the share of a period the server waits
 #                      for late answers (default 0.6; the shipped default is 0.25)
 #   --floor-time S     floor seconds measured per N (default 5)
+#   --floor-repeats K  floor runs per N and discovery, all sizes once per round (default 3);
+#                      ratios use the median: one 5 s sample moved 1.7x within minutes
 #   --skip floor,lockstep,realtime,hosts,table1   parts to leave out
 #   --hosts-drones N   agent-host part: N drones of config/swarm_field.yaml in real time,
 #                      flown by --agent-hosts K processes (default 512 and 2), physics and
@@ -44,6 +46,7 @@ RT_SIZES=""
 LS_TIME=10
 RT_TIME=60
 FLOOR_TIME=5
+FLOOR_REPEATS=3
 SKIP=""
 T1_RUNS=15
 PLOT=""
@@ -67,6 +70,7 @@ while [ $# -gt 0 ]; do
     --time) LS_TIME="$2"; shift 2 ;;
     --rt-time) RT_TIME="$2"; shift 2 ;;
     --floor-time) FLOOR_TIME="$2"; shift 2 ;;
+    --floor-repeats) FLOOR_REPEATS="$2"; shift 2 ;;
     --skip) SKIP="$2"; shift 2 ;;
     --table1-runs) T1_RUNS="$2"; shift 2 ;;
     --plot) PLOT="$2"; shift 2 ;;
@@ -78,7 +82,7 @@ while [ $# -gt 0 ]; do
     --hosts-physics) HOSTS_PHYS="$2"; shift 2 ;;
     --hosts-sensors) HOSTS_SENS="$2"; shift 2 ;;
     --table1-jobs) T1_JOBS="$2"; shift 2 ;;
-    --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; T1_RUNS=1; HOSTS_N=16; shift ;;
+    --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; FLOOR_REPEATS=1; T1_RUNS=1; HOSTS_N=16; shift ;;
     --lockstep) LS_VARIANTS="$2"; shift 2 ;;
     --rt-streams) RT_STREAMS="$2"; shift 2 ;;
     --rt-grace) RT_GRACE="$2"; shift 2 ;;
@@ -120,18 +124,37 @@ if ! skip floor; then
   rm -f "$FLOOR_CSV"
   # Explicit participant ids, as ddswarm-launch gives large swarms' agents:
   # past ~100 participants automatic ids leave the rest unreachable.
-  "$BIN/dds_floor" --drones "$(echo $SIZES | tr ' ' ',')" --discovery both --time "$FLOOR_TIME" \
-    --explicit-ids --csv "$FLOOR_CSV" --log-dir "$OUT/floor-logs"
+  # Rounds over every size, so the repeats of one N lie minutes apart.
+  for round in $(seq "$FLOOR_REPEATS"); do
+    echo "swarm_bench: floor round $round of $FLOOR_REPEATS" >&2
+    "$BIN/dds_floor" --drones "$(echo $SIZES | tr ' ' ',')" --discovery both --time "$FLOOR_TIME" \
+      --explicit-ids --csv "$FLOOR_CSV" --log-dir "$OUT/floor-logs"
+  done
+  if [ "$FLOOR_REPEATS" -gt 1 ]; then
+    echo
+    echo "== the floor over $FLOOR_REPEATS rounds: median (min-max) ticks/s; the ratios below use the median =="
+    echo "| N | simple discovery | discovery server |"
+    echo "|---|---|---|"
+    $PY - "$FLOOR_CSV" $SIZES <<'EOF'
+import csv, statistics, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
+def cell(n, d):
+    v = sorted(float(r["ticks_per_s"]) for r in rows if int(r["n"]) == n and r["discovery"] == d)
+    return f"{statistics.median(v):.0f} ({v[0]:.0f}-{v[-1]:.0f})" if v else "-"
+for n in map(int, sys.argv[2:]):
+    print(f"| {n} | {cell(n, 'simple')} | {cell(n, 'server')} |")
+EOF
+  fi
 fi
-# floor_of N: ticks/s of the floor with the discovery the launcher's auto picks.
+# floor_of N: median ticks/s of the floor runs with the discovery the launcher's auto picks.
 floor_of() {
   [ -f "$FLOOR_CSV" ] || { echo nan; return; }
   $PY - "$FLOOR_CSV" "$1" <<'EOF'
-import csv, sys
+import csv, statistics, sys
 rows = [r for r in csv.DictReader(open(sys.argv[1])) if int(r["n"]) == int(sys.argv[2]) and r["ok"] == "1"]
 want = "server" if int(sys.argv[2]) > 32 else "simple"
-pick = [r for r in rows if r["discovery"] == want] or rows
-print(pick[0]["ticks_per_s"] if pick else "nan")
+pick = [float(r["ticks_per_s"]) for r in rows if r["discovery"] == want] or [float(r["ticks_per_s"]) for r in rows]
+print(statistics.median(pick) if pick else "nan")
 EOF
 }
 
