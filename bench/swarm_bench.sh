@@ -119,6 +119,19 @@ trap 'exit 130' INT TERM
 echo "swarm_bench: load before start: $(cut -d' ' -f1-3 /proc/loadavg); results in $OUT"
 
 # ---------------------------------------------------------------- floor
+# floor_stats N DISCOVERY [any]: "median min max" ticks/s of the floor's good
+# runs of N with that discovery ("any": all of N's runs when it has none), or "nan".
+floor_stats() {
+  [ -f "$FLOOR_CSV" ] || { echo nan; return; }
+  $PY - "$FLOOR_CSV" "$@" <<'EOF'
+import csv, statistics, sys
+n, want = int(sys.argv[2]), sys.argv[3]
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if int(r["n"]) == n and r["ok"] == "1"]
+pick = [r for r in rows if r["discovery"] == want] or (rows if sys.argv[4:] == ["any"] else [])
+v = sorted(float(r["ticks_per_s"]) for r in pick)
+print(f"{statistics.median(v)} {v[0]} {v[-1]}" if v else "nan")
+EOF
+}
 FLOOR_CSV="$OUT/floor.csv"
 if ! skip floor; then
   rm -f "$FLOOR_CSV"
@@ -135,27 +148,15 @@ if ! skip floor; then
     echo "== the floor over $FLOOR_REPEATS rounds: median (min-max) ticks/s; the ratios below use the median =="
     echo "| N | simple discovery | discovery server |"
     echo "|---|---|---|"
-    $PY - "$FLOOR_CSV" $SIZES <<'EOF'
-import csv, statistics, sys
-rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
-def cell(n, d):
-    v = sorted(float(r["ticks_per_s"]) for r in rows if int(r["n"]) == n and r["discovery"] == d)
-    return f"{statistics.median(v):.0f} ({v[0]:.0f}-{v[-1]:.0f})" if v else "-"
-for n in map(int, sys.argv[2:]):
-    print(f"| {n} | {cell(n, 'simple')} | {cell(n, 'server')} |")
-EOF
+    floor_cell() { floor_stats "$1" "$2" | awk '{ print ($1 == "nan") ? "-" : sprintf("%.0f (%.0f-%.0f)", $1, $2, $3) }'; }
+    for n in $SIZES; do echo "| $n | $(floor_cell "$n" simple) | $(floor_cell "$n" server) |"; done
   fi
 fi
 # floor_of N: median ticks/s of the floor runs with the discovery the launcher's auto picks.
 floor_of() {
-  [ -f "$FLOOR_CSV" ] || { echo nan; return; }
-  $PY - "$FLOOR_CSV" "$1" <<'EOF'
-import csv, statistics, sys
-rows = [r for r in csv.DictReader(open(sys.argv[1])) if int(r["n"]) == int(sys.argv[2]) and r["ok"] == "1"]
-want = "server" if int(sys.argv[2]) > 32 else "simple"
-pick = [float(r["ticks_per_s"]) for r in rows if r["discovery"] == want] or [float(r["ticks_per_s"]) for r in rows]
-print(statistics.median(pick) if pick else "nan")
-EOF
+  local want=simple
+  [ "$1" -gt 32 ] && want=server
+  floor_stats "$1" "$want" any | cut -d' ' -f1
 }
 
 # ---------------------------------------------------------------- one swarm

@@ -52,8 +52,7 @@ MixerResult Mixer::mix(const Wrench& demand) const {
     }
   s_max = std::clamp(s_max, 0.0, 1.0);
 
-  double t_top = kInf;                // highest collective that fits at s*
-  const double t_floor = t_floor_;    // lowest collective any rotor setting allows
+  double t_top = kInf;  // highest collective that fits at s*
   for (int i = 0; i < 4; ++i) t_top = std::min(t_top, (hi - s_max * a[i]) / c_t[i]);
 
   double s = s_max;
@@ -63,7 +62,7 @@ MixerResult Mixer::mix(const Wrench& demand) const {
   } else {
     // Airmode off: never raise the collective; shrink roll/pitch until every
     // rotor stays above its minimum.
-    thrust = std::max(thrust, t_floor);
+    thrust = std::max(thrust, t_floor_);
     for (int i = 0; i < 4; ++i) {
       const double base = c_t[i] * thrust;
       if (a[i] > 0) s = std::min(s, (hi - base) / a[i]);

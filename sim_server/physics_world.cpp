@@ -257,22 +257,20 @@ PhysicsWorld::PhysicsWorld(const SceneConfig& scene, const QuadrotorParams& q,
   for (int i = 0; i < 4; ++i) rotor_pos_[i] = q.rotor_position_body(i);
 
   collision_config_ = std::make_unique<btDefaultCollisionConfiguration>();
-  const bool shortcuts = path == BulletPath::kShortcuts;
-  if (shortcuts)
-    dispatcher_ = std::make_unique<DroneDispatcher>(collision_config_.get(), scene.ground_z_m);
-  else
-    dispatcher_ = std::make_unique<btCollisionDispatcher>(collision_config_.get());
   broadphase_ = std::make_unique<btDbvtBroadphase>();
   solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
-  if (shortcuts)
+  if (path == BulletPath::kShortcuts) {
+    dispatcher_ = std::make_unique<DroneDispatcher>(collision_config_.get(), scene.ground_z_m);
     world_ = std::make_unique<DroneDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
                                                   solver_.get(), collision_config_.get());
-  else
+    // Static bodies never move: their AABBs need no update at every step (by
+    // default Bullet recomputes all of them; the thesis course has 16 obstacles).
+    world_->setForceUpdateAllAabbs(false);
+  } else {
+    dispatcher_ = std::make_unique<btCollisionDispatcher>(collision_config_.get());
     world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(),
                                                        solver_.get(), collision_config_.get());
-  // Static bodies never move: their AABBs need no update at every step (by
-  // default Bullet recomputes all of them; the thesis course has 16 obstacles).
-  world_->setForceUpdateAllAabbs(!shortcuts);
+  }
   world_->setGravity(btVector3(0, 0, static_cast<btScalar>(-kGravityMps2)));
 
   add_static(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1),
