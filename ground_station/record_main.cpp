@@ -51,7 +51,12 @@ int main(int argc, char** argv) {
     auto counts = rec.run(duration_s);
     std::uint64_t total = 0;
     for (const auto& [topic, n] : counts.messages) {
-      if (n) std::fprintf(stderr, "  %-24s %llu\n", topic.c_str(), static_cast<unsigned long long>(n));
+      auto missed = counts.missed.find(topic);
+      if (missed != counts.missed.end())
+        std::fprintf(stderr, "  %-24s %llu (%llu more were sent but never received)\n", topic.c_str(),
+                     static_cast<unsigned long long>(n), static_cast<unsigned long long>(missed->second));
+      else if (n)
+        std::fprintf(stderr, "  %-24s %llu\n", topic.c_str(), static_cast<unsigned long long>(n));
       total += n;
     }
     std::fprintf(stderr, "ddswarm-record: %llu messages, %.2f MB written to %s (peak queue %zu)\n",

@@ -18,6 +18,7 @@
 #include "common/participant.hpp"
 #include "common/process.hpp"
 #include "ddswarm_idl_text.hpp"
+#include "ground_station/sequence_gaps.hpp"
 
 namespace ddswarm::gs {
 
@@ -65,6 +66,7 @@ struct Recorder::Impl {
   std::map<std::uint16_t, std::string> channel_topic;
   std::map<std::string, std::uint64_t> written;
   std::size_t not_written = 0;  // of a batch whose write failed
+  std::map<std::string, SequenceGaps> gaps_of;  // per topic, under mu: samples sent that never came
 
   static mcap::WriterOptions writer_options(const RecorderOptions& o) {
     mcap::WriterOptions w;
@@ -95,13 +97,21 @@ struct Recorder::Impl {
           writer.add_channel(schema, topic, "cdr", {{"qos_profile", Topic<T>::profile}});
       channel_topic[channel] = topic;
       written[topic] = 0;
-      dds.reader<T>([this, channel](const T& sample, const fdds::SampleInfo& info) {
-        Item it{channel, now_ns(), static_cast<std::uint64_t>(info.source_timestamp.to_ns()), to_cdr(sample)};
-        std::lock_guard<std::mutex> lock(mu);
-        queue.push_back(std::move(it));
-        max_queue = std::max(max_queue, queue.size());
-        cv.notify_one();
-      });
+      SequenceGaps* gaps = &gaps_of[topic];
+      dds.reader<T>(
+          [this, channel, gaps](const T& sample, const fdds::SampleInfo& info) {
+            Item it{channel, now_ns(), static_cast<std::uint64_t>(info.source_timestamp.to_ns()), to_cdr(sample)};
+            const auto& guid = info.sample_identity.writer_guid();
+            SequenceGaps::WriterId writer_id;
+            std::copy_n(guid.guidPrefix.value, 12, writer_id.begin());
+            std::copy_n(guid.entityId.value, 4, writer_id.begin() + 12);
+            std::lock_guard<std::mutex> lock(mu);
+            gaps->received(writer_id, info.sample_identity.sequence_number().to64long());
+            queue.push_back(std::move(it));
+            max_queue = std::max(max_queue, queue.size());
+            cv.notify_one();
+          },
+          std::nullopt, Delivery::kArchive);
     });
   }
 
@@ -167,6 +177,8 @@ struct Recorder::Impl {
     c.messages = written;
     c.bytes = writer.bytes_written();
     c.max_queue = max_queue;
+    for (const auto& [topic, gaps] : gaps_of)
+      if (gaps.missed()) c.missed[topic] = gaps.missed();
     return c;
   }
 };

@@ -23,6 +23,11 @@ struct RecorderCounts {
   std::map<std::string, std::uint64_t> messages;  ///< per topic, written
   std::uint64_t bytes = 0;                        ///< file size
   std::size_t max_queue = 0;                      ///< most samples waiting for the disk at once
+  /// per topic, only where it is not 0: samples a writer sent after the
+  /// recorder joined that never reached it (gaps in the writer's sequence
+  /// numbers: best-effort losses, or a KEEP_LAST writer that replaced them
+  /// before they were delivered); they are not in the file
+  std::map<std::string, std::uint64_t> missed;
 };
 
 class Recorder {

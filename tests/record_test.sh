@@ -26,6 +26,24 @@ else
   echo "note: node or @mcap/core not installed; independent reader skipped"
 fi
 
+grep -q "never received" "$WORK/rec1.log" && fail "the recorder missed samples of an unhurried publisher"
+
+# 1b. A recorder frozen for a second while samples flow keeps what the
+#     writers still hold and says exactly how many it never received: per
+#     topic, written + missed = sent.
+start rec4 "$BIN/ddswarm-record" -o "$WORK/d.mcap" --domain "$DOMAIN" --topics ddswarm/collision,ddswarm/mission_ack,ddswarm/swarm_state
+sleep 1
+start freezer bash -c "sleep 2; kill -STOP $PID_rec4; sleep 1; kill -CONT $PID_rec4"
+"$BIN/count_publisher" --domain "$DOMAIN" --count 1000 || fail "publisher"
+wait_pid "$PID_freezer" 10 || fail "freezer"
+kill -INT "$PID_rec4"; wait_pid "$PID_rec4" 15 || fail "the frozen recorder did not finish on SIGINT"
+for t in collision mission_ack swarm_state; do
+  line=$(grep -E "^  ddswarm/$t " "$WORK/rec4.log") || fail "no count for ddswarm/$t"
+  read -r _ written missed <<<"$(echo "$line" | sed -E 's/\((.*) more.*/\1/')"
+  echo "ddswarm/$t: written $written, reported missed ${missed:-0}"
+  [ $((written + ${missed:-0})) -eq 1000 ] || fail "ddswarm/$t: $written written + ${missed:-0} reported missed != 1000 sent"
+done
+
 # 2. Replay reproduces the same sequence (recorded again, compared message by message).
 start rec2 "$BIN/ddswarm-record" -o "$WORK/b.mcap" --domain "$DOMAIN" --topics ddswarm/collision,ddswarm/mission_ack,ddswarm/swarm_state
 sleep 1

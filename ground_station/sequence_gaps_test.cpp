@@ -1,0 +1,35 @@
+#include "ground_station/sequence_gaps.hpp"
+
+#include <gtest/gtest.h>
+
+namespace ddswarm::gs {
+namespace {
+
+SequenceGaps::WriterId writer(std::uint8_t k) {
+  SequenceGaps::WriterId w{};
+  w[15] = k;
+  return w;
+}
+
+TEST(SequenceGaps, CountsWhatEachWriterSkipped) {
+  SequenceGaps g;
+  for (std::uint64_t s : {7, 8, 11, 12}) g.received(writer(1), s);  // joined at 7: owed nothing before; 9, 10 lost
+  for (std::uint64_t s : {1, 2, 6}) g.received(writer(2), s);        // its own numbers: 3, 4, 5 lost
+  EXPECT_EQ(g.missed(), 5u);
+  EXPECT_EQ(g.writers(), 2u);
+}
+
+TEST(SequenceGaps, AGapFilledLaterIsNoLoss) {
+  SequenceGaps g;
+  for (std::uint64_t s : {1, 2, 5, 6}) g.received(writer(1), s);
+  EXPECT_EQ(g.missed(), 2u);
+  g.received(writer(1), 4);  // a repair after a newer sample of another instance
+  g.received(writer(1), 3);
+  EXPECT_EQ(g.missed(), 0u);
+  g.received(writer(3), 10);
+  g.received(writer(3), 9);  // older than the first received: the span grows down
+  EXPECT_EQ(g.missed(), 0u);
+}
+
+}  // namespace
+}  // namespace ddswarm::gs
