@@ -60,9 +60,9 @@ class Writer {
 /// kArchive is for readers that must keep every sample (the recorder): the
 /// profile's reliability, but by the transport, never by data-sharing. A
 /// data-sharing writer with a KEEP_LAST history reuses a sample's slot in its
-/// pool `depth` samples later, even if a reader has not read it yet (a
-/// recorder descheduled for 17 ms at 240 samples/s lost 1-4 of 300); the
-/// transport queues the sample in the reader's own port instead. (Fast DDS
+/// pool `depth` samples later, even if a reader has not read it yet (under
+/// load, a recorder lost 1-4 of 300 swarm states replayed at 240/s in 5 of
+/// 10 runs); the transport queues the sample in the reader's own port instead. (Fast DDS
 /// 2.9.1 reports such a loss in the sample-lost status only sometimes: in
 /// one of six runs of Participant.ArchiveReaderKeepsEverySampleThroughAStall;
 /// count gaps in the writer's sequence numbers instead, as the recorder does.)
