@@ -1,6 +1,7 @@
 // ddswarm-record: records the swarm's DDS traffic to an MCAP file;
 // `ddswarm-record info FILE` describes a recording.
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -51,12 +52,11 @@ int main(int argc, char** argv) {
     auto counts = rec.run(duration_s);
     std::uint64_t total = 0;
     for (const auto& [topic, n] : counts.messages) {
-      auto missed = counts.missed.find(topic);
-      if (missed != counts.missed.end())
-        std::fprintf(stderr, "  %-24s %llu (%llu more were sent but never received)\n", topic.c_str(),
-                     static_cast<unsigned long long>(n), static_cast<unsigned long long>(missed->second));
-      else if (n)
-        std::fprintf(stderr, "  %-24s %llu\n", topic.c_str(), static_cast<unsigned long long>(n));
+      const auto missed = counts.missed.count(topic) ? counts.missed.at(topic) : 0;
+      const auto note = missed ? fmt::format(" ({} more were sent but never received)", missed) : "";
+      if (n || missed)
+        std::fprintf(stderr, "  %-24s %llu%s\n", topic.c_str(), static_cast<unsigned long long>(n),
+                     note.c_str());
       total += n;
     }
     std::fprintf(stderr, "ddswarm-record: %llu messages, %.2f MB written to %s (peak queue %zu)\n",
