@@ -43,6 +43,7 @@ struct SwarmStatus {
   std::int64_t commands_applied = -1;
   std::int64_t commands_late = -1;
   std::string task;             ///< the refereed task, e.g. "running 12.0 s, 2/6 past finish"; "" = none
+  int drones_server_hears = -1;  ///< drones whose agent the server lists live (-1: no server heard)
 };
 
 /// The commands of the thesis console (Fig. 9), plus hold and teleop.

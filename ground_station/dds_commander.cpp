@@ -122,6 +122,17 @@ struct DdsCommander::Impl {
     return online_locked().size() >= static_cast<std::size_t>(want);
   }
 
+  /// The server's own latest status lists count agents live (count < 0:
+  /// every drone). A ground station can hear an agent that the server does
+  /// not: under load, discovery may have matched the agent with this process
+  /// but not yet with the server, and the server releases a mission command
+  /// only to the agents it hears.
+  bool server_hears_at_least(int count) const {
+    if (!sim) return false;
+    const int want = count >= 0 ? count : sim->num_drones();
+    return sim->live_agents().size() >= static_cast<std::size_t>(want);
+  }
+
   /// Agents heard recently, plus those the server (the authority on
   /// liveness) reports live in its latest status.
   std::set<int> online_locked() const {
@@ -270,7 +281,9 @@ DdsCommander::DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds)
 DdsCommander::~DdsCommander() = default;
 
 bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
-  return impl_->wait(timeout_s, [&] { return impl_->online_at_least(count) && impl_->all_matched(); });
+  return impl_->wait(timeout_s, [&] {
+    return impl_->online_at_least(count) && impl_->server_hears_at_least(count) && impl_->all_matched();
+  });
 }
 
 bool DdsCommander::wait_for_online(int count, double timeout_s) {
@@ -500,6 +513,7 @@ SwarmStatus DdsCommander::status() {
     s.sim_time_s = m.sim_time_s();
     s.real_time_factor = m.real_time_factor();
     s.drones_total = m.num_drones();
+    s.drones_server_hears = static_cast<int>(m.live_agents().size());
     s.airborne = m.airborne();
     s.collisions = static_cast<int>(m.collisions_obstacle() + m.collisions_drone() + m.collisions_ground());
     s.mode = (m.mode() == msg::MODE_LOCKSTEP ? "lockstep, " : "realtime, ") + m.state().to_string();

@@ -36,8 +36,11 @@ class DdsCommander final : public Commander {
   DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds);
   ~DdsCommander() override;
 
-  /// Waits until the server is heard and count agents are online (count < 0:
-  /// as many as the server's scenario has). Returns false on timeout.
+  /// Waits until the server is heard, count agents are online both to this
+  /// process and in the server's own status (count < 0: as many as the
+  /// server's scenario has), and this process's writers and readers are
+  /// matched: everything a mission needs before its first command. Returns
+  /// false on timeout.
   bool wait_for_swarm(int count, double timeout_s);
   /// Waits until the server is heard and count agents are online in its view
   /// (count < 0: as many as the scenario has), without waiting for this

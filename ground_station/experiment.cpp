@@ -24,7 +24,8 @@ TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
   TaskOutcome fail;
   if (!gs.wait_for_swarm(drones, 30.0)) {
     auto st = gs.status();
-    fail.reason = fmt::format("only {}/{} agents online after 30 s", st.drones_online, drones);
+    fail.reason = fmt::format("only {}/{} agents online ({} heard by the server) after 30 s", st.drones_online,
+                              drones, std::max(st.drones_server_hears, 0));
     return fail;
   }
   auto r = gs.takeoff(0);

@@ -1,0 +1,90 @@
+// The ground station starts a mission only when the server hears every agent:
+// under load, discovery can match an agent with the ground station seconds
+// before it matches the server, and the server releases a command only to
+// the agents it hears (an experiment run once failed so: "takeoff 5/6
+// acknowledged; no ack from drones 0").
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "common/participant.hpp"
+#include "common/process.hpp"
+#include "ground_station/dds_commander.hpp"
+
+namespace ddswarm::gs {
+namespace {
+
+/// Stands in for a server and six agents in one participant: heartbeats for
+/// every drone, a SimStatus listing only `server_hears` of them.
+class FakeSwarm {
+ public:
+  explicit FakeSwarm(const DdsConfig& cfg)
+      : dds_(cfg, "fake_swarm"),
+        w_status_(dds_.writer<msg::SimStatus>()),
+        w_agent_(dds_.writer<msg::AgentStatus>()),
+        w_ack_(dds_.writer<msg::MissionAck>()) {
+    dds_.reader<msg::MissionCommand>([](const msg::MissionCommand&, const fdds::SampleInfo&) {});
+    thread_ = std::thread([this] {
+      while (!stop_) {
+        publish();
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    });
+  }
+  ~FakeSwarm() {
+    stop_ = true;
+    thread_.join();
+  }
+  void server_hears(int n) { server_hears_ = n; }
+
+ private:
+  void publish() {
+    msg::SimStatus s;
+    s.mode(msg::MODE_LOCKSTEP);
+    s.num_drones(kDrones);
+    for (int i = 0; i < kDrones; ++i)
+      if (i >= kDrones - server_hears_) s.live_agents().push_back(static_cast<std::uint16_t>(i));
+    s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
+    w_status_.write(s);
+    for (int i = 0; i < kDrones; ++i) {
+      msg::AgentStatus a;
+      a.drone_id(static_cast<std::uint16_t>(i));
+      a.host("fake");
+      a.pid(static_cast<std::uint32_t>(::getpid()));  // one process: one ack writer to match
+      w_agent_.write(a);
+    }
+  }
+
+  static constexpr int kDrones = 6;
+  Participant dds_;
+  Writer<msg::SimStatus> w_status_;
+  Writer<msg::AgentStatus> w_agent_;
+  Writer<msg::MissionAck> w_ack_;
+  std::atomic<int> server_hears_{0};
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+TEST(DdsCommander, WaitsForTheServerToHearEveryAgentNotOnlyItself) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  FakeSwarm swarm(cfg);
+  swarm.server_hears(5);  // drone 0 matched the ground station, not yet the server
+  DdsCommander gs(GroundStationConfig{}, cfg);
+
+  ASSERT_TRUE(gs.wait_for_online(6, 10.0)) << "the ground station never heard the six heartbeats";
+  EXPECT_FALSE(gs.wait_for_swarm(6, 1.0));
+  const auto st = gs.status();
+  EXPECT_EQ(st.drones_online, 6);
+  EXPECT_EQ(st.drones_server_hears, 5);
+
+  swarm.server_hears(6);
+  EXPECT_TRUE(gs.wait_for_swarm(6, 10.0));
+}
+
+}  // namespace
+}  // namespace ddswarm::gs
