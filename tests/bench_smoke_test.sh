@@ -17,4 +17,13 @@ done
 grep -Eq '^\| 3 \| [0-9.]+ \| [0-9]+ / [0-9]+ / [0-9]+ \|' "$out" || fail "real-time row for N=3 missing or empty"
 grep -Eq '^\| task flight \| [0-9.]+ \|' "$out" || fail "Table 1 split missing"
 grep -q "4 runs, 0 failed" "$out" || fail "Table 1 quick runs failed"
+# Where the wake-ups go: each process's threads, woken and CPU per tick.
+start wakes bash "$SRC/bench/thread_wakes.sh" --bin "$BIN" --time 2 --out "$WORK/wakes" 3
+wait_pid "$PID_wakes" 150; rc=$?
+[ $rc -eq 0 ] || fail "thread_wakes exit $rc"
+grep -Eq '^== lockstep, N=3: [1-9][0-9]* ticks' "$WORK/wakes.log" || fail "thread_wakes counted no ticks"
+for who in sim agent; do
+  sed -n "/^-- $who /,/^--/p" "$WORK/wakes.log" | grep -Eq '^\| [0-9]+ \| [0-9.]+ \| [0-9.]+ \| [0-9.]+ \|' ||
+    fail "thread_wakes: no thread row for the $who"
+done
 echo PASS

@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# Issue 8: where the wake-ups go. Launches N agent processes in lockstep,
+# takes off, holds, then counts each thread's context switches (voluntary =
+# it slept and was woken; involuntary = preempted) and CPU over a few seconds
+# of ticking, for the server and agent 1, per tick. With --stacks, also saves
+# every thread's stack (gdb) so a thread id can be told apart: Fast DDS's
+# threads are all named after the process.
+# Usage: bench/thread_wakes.sh [--bin DIR] [--time S] [--out DIR] [--stacks] N
+set -u
+SRC="$(cd "$(dirname "$0")/.." && pwd)"
+BIN="$SRC/build/default/bin"
+SECS=5
+OUT=""
+STACKS=0
+N=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --bin) BIN="$2"; shift 2 ;;
+    --time) SECS="$2"; shift 2 ;;
+    --out) OUT="$2"; shift 2 ;;
+    --stacks) STACKS=1; shift ;;
+    -h|--help) sed -n '2,8p' "$0"; exit 0 ;;
+    *) N="$1"; shift ;;
+  esac
+done
+[ -n "$N" ] || { echo "thread_wakes: give N, the number of agent processes" >&2; exit 2; }
+[ -n "$OUT" ] || OUT="$(mktemp -d /tmp/ddswarm-wakes.XXXXXX)"
+mkdir -p "$OUT"
+source "$SRC/bench/bench_lib.sh"
+SCENARIO="$OUT/scenario.yaml"
+bench_scenario "$SCENARIO"
+dom=$(bench_domain)
+"$BIN/ddswarm-launch" "$SCENARIO" --drones "$N" --mode lockstep --domain "$dom" --log-dir "$OUT" \
+  --discovery-server auto --duration 600 >"$OUT/launch.out" 2>"$OUT/launch.err" &
+LAUNCH_PID=$!
+stop_launch() {
+  kill -TERM "$LAUNCH_PID" 2>/dev/null
+  for _ in $(seq 150); do kill -0 "$LAUNCH_PID" 2>/dev/null || break; sleep 0.1; done
+  kill -KILL "$LAUNCH_PID" 2>/dev/null
+  wait "$LAUNCH_PID" 2>/dev/null
+}
+trap stop_launch EXIT
+trap 'exit 130' INT TERM
+for _ in $(seq 50); do grep -q "started .* process" "$OUT/launch.err" 2>/dev/null && break; sleep 0.1; done
+ds=()
+addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$OUT/launch.err")
+[ -n "$addr" ] && ds=(--discovery-server "$addr")
+gs=("$BIN/ddswarm-gs" --config "$SCENARIO" --domain "$dom" "${ds[@]}")
+timeout 320 "${gs[@]}" wait-agents --count "$N" --timeout 300 >/dev/null 2>&1 ||
+  { echo "thread_wakes: agents not online (logs in $OUT)" >&2; exit 1; }
+timeout 260 "${gs[@]}" takeoff --wait >/dev/null 2>&1 || { echo "thread_wakes: takeoff failed (logs in $OUT)" >&2; exit 1; }
+timeout 60 "${gs[@]}" hold --time 86400 >/dev/null 2>&1
+sleep 2
+sim=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
+agent=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
+[ -n "$sim" ] && [ -n "$agent" ] || { echo "thread_wakes: server or agent 1 not found" >&2; exit 1; }
+
+snap() {  # snap PID -> "tid voluntary involuntary cpu_ticks" per thread
+  for t in /proc/"$1"/task/*; do
+    echo "$(basename "$t") $(awk '/^voluntary_ctxt/{v=$2} /^nonvoluntary/{n=$2} END{print v, n}' "$t/status")" \
+         "$(awk '{sub(/.*\) /, ""); print $12 + $13}' "$t/stat")"
+  done 2>/dev/null | sort
+}
+sim_tick() { timeout 5 "${gs[@]}" status 2>/dev/null | grep -o 'sim [0-9.]*' | head -1 | cut -d' ' -f2; }
+t0=$(sim_tick); w0=$(date +%s.%N); snap "$sim" >"$OUT/sim0"; snap "$agent" >"$OUT/agent0"
+sleep "$SECS"
+t1=$(sim_tick); w1=$(date +%s.%N); snap "$sim" >"$OUT/sim1"; snap "$agent" >"$OUT/agent1"
+if [ "$STACKS" = 1 ]; then
+  gdb -p "$agent" -batch -ex "thread apply all bt 8" >"$OUT/agent_stacks.txt" 2>&1
+  gdb -p "$sim" -batch -ex "thread apply all bt 8" >"$OUT/sim_stacks.txt" 2>&1
+fi
+ticks=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%d", (b - a) * 50 }')  # 50 Hz control
+[ "$ticks" -gt 0 ] || { echo "thread_wakes: the swarm did not tick" >&2; exit 1; }
+hz=$(getconf CLK_TCK)
+echo "== lockstep, N=$N: $ticks ticks in $(awk -v a="$w0" -v b="$w1" 'BEGIN { printf "%.1f", b - a }') s;" \
+  "per tick, the threads that woke at least once in 100 ticks =="
+for who in sim agent; do
+  echo "-- $who (pid $([ $who = sim ] && echo "$sim" || echo "$agent")) --"
+  echo "| thread | woken | preempted | CPU (µs) |"
+  echo "|---|---|---|---|"
+  join "$OUT/${who}0" "$OUT/${who}1" | awk -v T="$ticks" -v hz="$hz" '{
+    v = ($5 - $2) / T; n = ($6 - $3) / T; c = ($7 - $4) * 1e6 / hz / T
+    if (v + n >= 0.01) printf "| %s | %.2f | %.2f | %.1f |\n", $1, v, n, c }'
+done
+[ "$STACKS" = 1 ] && echo "stacks: $OUT/agent_stacks.txt, $OUT/sim_stacks.txt"
+exit 0
