@@ -18,3 +18,35 @@ bench_scenario() {
   grep -q "discovery_timeout_s: 60.0" "$1" && grep -q "^    neighbours: 6$" "$1" ||
     { echo "$(basename "$0"): cannot derive $1" >&2; exit 2; }
 }
+
+# bench_hold_swarm MODE N DIR SCENARIO: starts ddswarm-launch (N agent
+# processes, MODE lockstep|realtime, logs in DIR) in the background, waits for
+# every agent, takes off and holds. Sets LAUNCH_PID and GS (the ground-station
+# command line for this swarm); returns 1 with a message when the swarm did
+# not come up. bench_stop_launch stops it by PID.
+LAUNCH_PID=""
+bench_hold_swarm() {
+  local mode="$1" n="$2" dir="$3" scenario="$4" dom addr
+  dom=$(bench_domain)
+  "$BIN/ddswarm-launch" "$scenario" --drones "$n" --mode "$mode" --domain "$dom" --log-dir "$dir" \
+    --discovery-server auto --duration 900 >"$dir/launch.out" 2>"$dir/launch.err" &
+  LAUNCH_PID=$!
+  for _ in $(seq 50); do grep -q "started .* process" "$dir/launch.err" 2>/dev/null && break; sleep 0.1; done
+  local ds=()
+  addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$dir/launch.err")
+  [ -n "$addr" ] && ds=(--discovery-server "$addr")
+  GS=("$BIN/ddswarm-gs" --config "$scenario" --domain "$dom" "${ds[@]}")
+  timeout 320 "${GS[@]}" wait-agents --count "$n" --timeout 300 >/dev/null 2>&1 ||
+    { echo "N=$n: agents not online (logs in $dir)"; return 1; }
+  timeout 260 "${GS[@]}" takeoff --wait >/dev/null 2>&1 || { echo "N=$n: takeoff failed (logs in $dir)"; return 1; }
+  timeout 60 "${GS[@]}" hold --time 86400 >/dev/null 2>&1
+  return 0
+}
+bench_stop_launch() {
+  [ -n "$LAUNCH_PID" ] || return 0
+  kill -TERM "$LAUNCH_PID" 2>/dev/null
+  for _ in $(seq 150); do kill -0 "$LAUNCH_PID" 2>/dev/null || break; sleep 0.1; done
+  kill -KILL "$LAUNCH_PID" 2>/dev/null
+  wait "$LAUNCH_PID" 2>/dev/null
+  LAUNCH_PID=""
+}

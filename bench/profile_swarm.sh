@@ -28,16 +28,7 @@ mkdir -p "$OUT"
 source "$SRC/bench/bench_lib.sh"
 SCENARIO="$OUT/profile_scenario.yaml"
 bench_scenario "$SCENARIO"
-LAUNCH_PID=""
-stop_launch() {
-  [ -n "$LAUNCH_PID" ] || return 0
-  kill -TERM "$LAUNCH_PID" 2>/dev/null
-  for _ in $(seq 150); do kill -0 "$LAUNCH_PID" 2>/dev/null || break; sleep 0.1; done
-  kill -KILL "$LAUNCH_PID" 2>/dev/null
-  wait "$LAUNCH_PID" 2>/dev/null
-  LAUNCH_PID=""
-}
-trap stop_launch EXIT
+trap bench_stop_launch EXIT
 trap 'exit 130' INT TERM
 
 cpu_split() {  # cpu_split PID -> "user_s sys_s"
@@ -53,20 +44,9 @@ report() {  # report NAME DATA
 }
 
 for n in "${SIZES[@]}"; do
-  dom=$(bench_domain)
   log="$OUT/$MODE-$n"
   mkdir -p "$log"
-  "$BIN/ddswarm-launch" "$SCENARIO" --drones "$n" --mode "$MODE" --domain "$dom" --log-dir "$log" \
-    --discovery-server auto --duration 900 >"$log/launch.out" 2>"$log/launch.err" &
-  LAUNCH_PID=$!
-  for _ in $(seq 50); do grep -q "started .* process" "$log/launch.err" 2>/dev/null && break; sleep 0.1; done
-  ds=()
-  addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$log/launch.err")
-  [ -n "$addr" ] && ds=(--discovery-server "$addr")
-  gs=("$BIN/ddswarm-gs" --config "$SCENARIO" --domain "$dom" "${ds[@]}")
-  timeout 320 "${gs[@]}" wait-agents --count "$n" --timeout 300 >/dev/null 2>&1 || { echo "N=$n: agents not online"; stop_launch; continue; }
-  timeout 260 "${gs[@]}" takeoff --wait >/dev/null 2>&1 || { echo "N=$n: takeoff failed"; stop_launch; continue; }
-  timeout 60 "${gs[@]}" hold --time 86400 >/dev/null 2>&1
+  bench_hold_swarm "$MODE" "$n" "$log" "$SCENARIO" || { bench_stop_launch; continue; }
   sleep 2
   sim=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
   agent=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
@@ -78,7 +58,7 @@ for n in "${SIZES[@]}"; do
   wait $p1 $p2
   read -r su1 ss1 < <(cpu_split "$sim"); read -r au1 as1 < <(cpu_split "$agent")
   threads_sim=$(ls /proc/"$sim"/task | wc -l); threads_agent=$(ls /proc/"$agent"/task | wc -l)
-  stop_launch
+  bench_stop_launch
   echo
   echo "==== $MODE, N=$n: ${SECS} s; load $(cut -d' ' -f1 /proc/loadavg) ===="
   awk -v su="$(echo "$su1 - $su0" | bc)" -v ss="$(echo "$ss1 - $ss0" | bc)" -v au="$(echo "$au1 - $au0" | bc)" \

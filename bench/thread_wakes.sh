@@ -29,27 +29,9 @@ mkdir -p "$OUT"
 source "$SRC/bench/bench_lib.sh"
 SCENARIO="$OUT/scenario.yaml"
 bench_scenario "$SCENARIO"
-dom=$(bench_domain)
-"$BIN/ddswarm-launch" "$SCENARIO" --drones "$N" --mode lockstep --domain "$dom" --log-dir "$OUT" \
-  --discovery-server auto --duration 600 >"$OUT/launch.out" 2>"$OUT/launch.err" &
-LAUNCH_PID=$!
-stop_launch() {
-  kill -TERM "$LAUNCH_PID" 2>/dev/null
-  for _ in $(seq 150); do kill -0 "$LAUNCH_PID" 2>/dev/null || break; sleep 0.1; done
-  kill -KILL "$LAUNCH_PID" 2>/dev/null
-  wait "$LAUNCH_PID" 2>/dev/null
-}
-trap stop_launch EXIT
+trap bench_stop_launch EXIT
 trap 'exit 130' INT TERM
-for _ in $(seq 50); do grep -q "started .* process" "$OUT/launch.err" 2>/dev/null && break; sleep 0.1; done
-ds=()
-addr=$(sed -n 's/.*discovery server on \([0-9.:]*\) .*/\1/p' "$OUT/launch.err")
-[ -n "$addr" ] && ds=(--discovery-server "$addr")
-gs=("$BIN/ddswarm-gs" --config "$SCENARIO" --domain "$dom" "${ds[@]}")
-timeout 320 "${gs[@]}" wait-agents --count "$N" --timeout 300 >/dev/null 2>&1 ||
-  { echo "thread_wakes: agents not online (logs in $OUT)" >&2; exit 1; }
-timeout 260 "${gs[@]}" takeoff --wait >/dev/null 2>&1 || { echo "thread_wakes: takeoff failed (logs in $OUT)" >&2; exit 1; }
-timeout 60 "${gs[@]}" hold --time 86400 >/dev/null 2>&1
+bench_hold_swarm lockstep "$N" "$OUT" "$SCENARIO" >&2 || exit 1
 sleep 2
 sim=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
 agent=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
@@ -61,7 +43,7 @@ snap() {  # snap PID -> "tid voluntary involuntary cpu_ticks" per thread
          "$(awk '{sub(/.*\) /, ""); print $12 + $13}' "$t/stat")"
   done 2>/dev/null | sort
 }
-sim_tick() { timeout 5 "${gs[@]}" status 2>/dev/null | grep -o 'sim [0-9.]*' | head -1 | cut -d' ' -f2; }
+sim_tick() { timeout 5 "${GS[@]}" status 2>/dev/null | grep -o 'sim [0-9.]*' | head -1 | cut -d' ' -f2; }
 t0=$(sim_tick); w0=$(date +%s.%N); snap "$sim" >"$OUT/sim0"; snap "$agent" >"$OUT/agent0"
 sleep "$SECS"
 t1=$(sim_tick); w1=$(date +%s.%N); snap "$sim" >"$OUT/sim1"; snap "$agent" >"$OUT/agent1"
