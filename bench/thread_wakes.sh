@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# Issue 8: where the wake-ups go. Launches N agent processes in lockstep,
-# takes off, holds, then counts each thread's context switches (voluntary =
+# Issue 8: where the wake-ups go. Launches N agent processes (lockstep by
+# default), takes off, holds, then counts each thread's context switches (voluntary =
 # it slept and was woken; involuntary = preempted) and CPU over a few seconds
 # of ticking, for the server and agent 1, per tick. With --stacks, also saves
 # every thread's stack (gdb) so a thread id can be told apart: Fast DDS's
 # threads are all named after the process.
-# Usage: bench/thread_wakes.sh [--bin DIR] [--time S] [--out DIR] [--stacks] N
+# Usage: bench/thread_wakes.sh [--bin DIR] [--mode lockstep|realtime] [--time S] [--out DIR] [--stacks] N
 set -u
 SRC="$(cd "$(dirname "$0")/.." && pwd)"
 BIN="$SRC/build/default/bin"
+MODE=lockstep
 SECS=5
 OUT=""
 STACKS=0
@@ -16,6 +17,7 @@ N=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --bin) BIN="$2"; shift 2 ;;
+    --mode) MODE="$2"; shift 2 ;;
     --time) SECS="$2"; shift 2 ;;
     --out) OUT="$2"; shift 2 ;;
     --stacks) STACKS=1; shift ;;
@@ -31,7 +33,7 @@ SCENARIO="$OUT/scenario.yaml"
 bench_scenario "$SCENARIO"
 trap bench_stop_launch EXIT
 trap 'exit 130' INT TERM
-bench_hold_swarm lockstep "$N" "$OUT" "$SCENARIO" >&2 || exit 1
+bench_hold_swarm "$MODE" "$N" "$OUT" "$SCENARIO" >&2 || exit 1
 sleep 2
 sim=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
 agent=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
@@ -54,7 +56,7 @@ fi
 ticks=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%d", (b - a) * 50 }')  # 50 Hz control
 [ "$ticks" -gt 0 ] || { echo "thread_wakes: the swarm did not tick" >&2; exit 1; }
 hz=$(getconf CLK_TCK)
-echo "== lockstep, N=$N: $ticks ticks in $(awk -v a="$w0" -v b="$w1" 'BEGIN { printf "%.1f", b - a }') s;" \
+echo "== $MODE, N=$N: $ticks ticks in $(awk -v a="$w0" -v b="$w1" 'BEGIN { printf "%.1f", b - a }') s;" \
   "per tick, the threads that woke at least once in 100 ticks =="
 for who in sim agent; do
   echo "-- $who (pid $([ $who = sim ] && echo "$sim" || echo "$agent")) --"
