@@ -115,22 +115,22 @@ struct DdsCommander::Impl {
     });
   }
 
-  /// The server is heard and count agents are online (count < 0: every drone).
-  bool online_at_least(int count) const {
-    if (!sim) return false;
-    const int want = count >= 0 ? count : sim->num_drones();
-    return online_locked().size() >= static_cast<std::size_t>(want);
+  /// count, or every drone of the server's scenario when count < 0. Needs sim.
+  std::size_t wanted(int count) const {
+    return static_cast<std::size_t>(count >= 0 ? count : sim->num_drones());
   }
+
+  /// The server is heard and count agents are online (count < 0: every drone).
+  bool online_at_least(int count) const { return sim && online_locked().size() >= wanted(count); }
 
   /// The server's own latest status lists count agents live (count < 0:
   /// every drone). A ground station can hear an agent that the server does
   /// not: under load, discovery may have matched the agent with this process
   /// but not yet with the server, and the server releases a mission command
-  /// only to the agents it hears.
+  /// only to the agents it hears. Implies online_at_least(count): the online
+  /// set includes the server's list.
   bool server_hears_at_least(int count) const {
-    if (!sim) return false;
-    const int want = count >= 0 ? count : sim->num_drones();
-    return sim->live_agents().size() >= static_cast<std::size_t>(want);
+    return sim && sim->live_agents().size() >= wanted(count);
   }
 
   /// Agents heard recently, plus those the server (the authority on
@@ -281,9 +281,7 @@ DdsCommander::DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds)
 DdsCommander::~DdsCommander() = default;
 
 bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
-  return impl_->wait(timeout_s, [&] {
-    return impl_->online_at_least(count) && impl_->server_hears_at_least(count) && impl_->all_matched();
-  });
+  return impl_->wait(timeout_s, [&] { return impl_->server_hears_at_least(count) && impl_->all_matched(); });
 }
 
 bool DdsCommander::wait_for_online(int count, double timeout_s) {

@@ -27,6 +27,8 @@ class FakeSwarm {
         w_status_(dds_.writer<msg::SimStatus>()),
         w_agent_(dds_.writer<msg::AgentStatus>()),
         w_ack_(dds_.writer<msg::MissionAck>()) {
+    // w_ack_ and this reader only match the ground station's ack reader and
+    // mission writer, which wait_for_swarm also waits for.
     dds_.reader<msg::MissionCommand>([](const msg::MissionCommand&, const fdds::SampleInfo&) {});
     thread_ = std::thread([this] {
       while (!stop_) {
