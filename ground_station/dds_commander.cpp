@@ -281,7 +281,8 @@ DdsCommander::DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds)
 DdsCommander::~DdsCommander() = default;
 
 bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
-  return impl_->wait(timeout_s, [&] { return impl_->server_hears_at_least(count) && impl_->all_matched(); });
+  auto& I = *impl_;
+  return I.wait(timeout_s, [&] { return I.server_hears_at_least(count) && I.all_matched(); });
 }
 
 bool DdsCommander::wait_for_online(int count, double timeout_s) {
