@@ -97,6 +97,10 @@ struct DroneBrain {
   std::vector<Eigen::Vector3d> ranged;
   std::vector<float> ranges, angles;
   std::vector<std::uint8_t> hits;
+  // The last answer sent. A tick that comes again (lockstep: the server
+  // published it twice, a sample was lost) gets the same answer again, not
+  // a second run of the mission machine and the law.
+  std::optional<msg::VelocityCommand> last_answer;
 
   explicit DroneBrain(int drone_id) : id(drone_id) {}
 
@@ -114,6 +118,7 @@ struct DroneBrain {
     seen_order.clear();
     fed_tick = ~0ULL;
     caught_up = false;
+    last_answer.reset();
   }
 };
 
@@ -140,11 +145,14 @@ struct AgentApp::Impl {
   double last_sample_wall = -1e9;
   bool server_lost = false;
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
+  std::mt19937_64 loss_rng;      // agent.state_loss: which samples to drop
+  std::uint64_t dropped = 0;     // samples dropped by agent.state_loss
   // This tick's swarm members (live agent, not in failsafe, finite position),
   // by id: converted once per sample for every brain in the process.
   std::vector<PeerObservation> roster;
-  // How the swarm state should be read, from the scene's mode: best-effort in
-  // real time (dds.best_effort_streams), reliably in lockstep. The run loop
+  // How the swarm state should be read: best-effort with
+  // dds.best_effort_streams, in both time modes (a lockstep server publishes
+  // a tick again when answers stay missing), else reliably. The run loop
   // makes the reader (not a DDS callback: Fast DDS endpoints are created and
   // deleted outside its threads) and is woken when this changes.
   std::optional<Delivery> states_wanted;
@@ -172,7 +180,8 @@ struct AgentApp::Impl {
         w_cmd(dds.writer<msg::VelocityCommand>(cfg.dds.secure() ? drone_partition(cfg.drone_ids.at(0)) : "")),
         w_status(dds.writer<msg::AgentStatus>()),
         w_ack(dds.writer<msg::MissionAck>()),
-        w_beacon(dds.writer<msg::Beacon>()) {
+        w_beacon(dds.writer<msg::Beacon>()),
+        loss_rng(0x5eed1055ULL + static_cast<std::uint64_t>(cfg.drone_ids.at(0))) {
     for (int id : cfg.drone_ids) {
       brains.push_back(std::make_unique<DroneBrain>(id));
       by_id[id] = brains.back().get();
@@ -222,7 +231,7 @@ struct AgentApp::Impl {
         std::nullopt, *want);
     states_delivery = *want;
     spdlog::info("{}: reading the swarm state {}", label,
-                 *want == Delivery::kLatest ? "best-effort (real time)" : "reliably");
+                 *want == Delivery::kLatest ? "best-effort" : "reliably");
   }
 
   /// The participant that announces the scene is the server: swarm samples
@@ -247,8 +256,7 @@ struct AgentApp::Impl {
       have_tick = false;
     }
     server_instance = s.server_instance();
-    states_wanted = s.mode() == msg::MODE_REALTIME && cfg.dds.best_effort_streams ? Delivery::kLatest
-                                                                                   : Delivery::kProfile;
+    states_wanted = cfg.dds.best_effort_streams ? Delivery::kLatest : Delivery::kProfile;
     woke.notify_all();
     control_period_s = 1.0 / s.control_rate_hz();
     scene_control_rate_hz = s.control_rate_hz();
@@ -309,6 +317,12 @@ struct AgentApp::Impl {
   void on_swarm(const msg::SwarmState& s, const eprosima::fastrtps::rtps::GuidPrefix_t& from) {
     std::lock_guard<std::mutex> lock(mu);
     if (!scene) return;  // no scene yet
+    if (cfg.agent.state_loss > 0 &&
+        std::uniform_real_distribution<double>(0.0, 1.0)(loss_rng) < cfg.agent.state_loss) {
+      if (dropped++ == 0) spdlog::info("{}: dropping {:.1f} % of swarm states (agent.state_loss)", label,
+                                       100 * cfg.agent.state_loss);
+      return;
+    }
     if (from != server || !std::isfinite(s.sim_time_s())) {  // not the server that announced the scene
       ++rejected;
       return;
@@ -352,6 +366,10 @@ struct AgentApp::Impl {
     const auto& me = s.drones()[id];
     if (!finite(me.position()) || !finite(me.velocity())) {
       ++b.rejected;
+      return;
+    }
+    if (b.last_answer && b.last_answer->tick() == s.tick()) {
+      w_cmd.write(*b.last_answer);
       return;
     }
 
@@ -487,6 +505,7 @@ struct AgentApp::Impl {
       if (new_tick) w_beacon.write(m);
     }
     w_cmd.write(cmd);
+    b.last_answer = cmd;
     ++b.sent;
   }
 

@@ -42,6 +42,8 @@ struct SwarmStatus {
   /// that arrived after the step they answered; -1 = no server heard.
   std::int64_t commands_applied = -1;
   std::int64_t commands_late = -1;
+  /// Lockstep: ticks the server published again, answers missing (SimStatus.lockstep_resends).
+  std::int64_t lockstep_resends = -1;
   std::string task;             ///< the refereed task, e.g. "running 12.0 s, 2/6 past finish"; "" = none
   int drones_server_hears = -1;  ///< drones whose agent the server lists live (-1: no server heard)
 };

@@ -536,6 +536,7 @@ SwarmStatus DdsCommander::status() {
     const auto& m = *impl_->sim;
     s.commands_applied = static_cast<std::int64_t>(m.commands_applied());
     s.commands_late = static_cast<std::int64_t>(m.commands_late());
+    s.lockstep_resends = static_cast<std::int64_t>(m.lockstep_resends());
     s.rejected = {{"non-finite", m.rejected_non_finite()}, {"absurd", m.rejected_absurd()},
                   {"unknown id", m.rejected_unknown_id()}, {"stale tick", m.rejected_stale_tick()},
                   {"future tick", m.rejected_future_tick()}, {"impostor", m.rejected_impostor()},

@@ -455,8 +455,11 @@ std::string format_rejections(const SwarmStatus& s) {
 
 std::string format_commands(const SwarmStatus& s) {
   if (s.commands_applied < 0) return "";
-  return "commands: " + std::to_string(s.commands_applied) + " applied, " + std::to_string(s.commands_late) +
-         " late (answered after their step)";
+  std::string line = "commands: " + std::to_string(s.commands_applied) + " applied, " +
+                     std::to_string(s.commands_late) + " late (answered after their step)";
+  if (s.lockstep_resends > 0)
+    line += "; " + std::to_string(s.lockstep_resends) + " ticks published again (answers missing)";
+  return line;
 }
 
 int run_menu(Commander& commander, LineReader& reader, std::ostream& out,

@@ -344,6 +344,9 @@ TEST(Status, CommandsAppliedAndLate) {
   s.commands_applied = 1200;
   s.commands_late = 3;
   EXPECT_EQ(format_commands(s), "commands: 1200 applied, 3 late (answered after their step)");
+  s.lockstep_resends = 2;  // lockstep: a sample lost, the tick went out again
+  EXPECT_EQ(format_commands(s),
+            "commands: 1200 applied, 3 late (answered after their step); 2 ticks published again (answers missing)");
 }
 
 }  // namespace

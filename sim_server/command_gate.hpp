@@ -4,6 +4,7 @@
 // rejected ever reaches a drone.
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 
 namespace ddswarm::sim {
 
@@ -15,6 +16,7 @@ enum class Verdict {
   kImpostor,     ///< another agent instance already flies this drone
   kStaleTick,    ///< older than what is being collected
   kFutureTick,   ///< for a tick not yet published
+  kRepeat,       ///< lockstep: the owner's answer again to a tick it already answered (published twice); not applied, not counted
 };
 
 const char* to_string(Verdict v);
@@ -33,6 +35,7 @@ struct GateContext {
   std::uint64_t oldest_ok_tick;  ///< lockstep: published_tick; realtime: last applied tick of this drone
   std::uint64_t owner_instance;  ///< the live agent instance of this drone, 0 = none
   double max_speed_mps;
+  std::optional<std::uint64_t> answered_tick = std::nullopt;  ///< lockstep: the tick the owner's applied answer was for
 };
 
 Verdict check_command(const CommandFacts& c, const GateContext& g);

@@ -48,3 +48,21 @@ TEST(CommandGate, RejectsStaleAndFutureTicks) {
   c.tick = 11;
   EXPECT_EQ(check_command(c, ctx()), Verdict::kFutureTick);
 }
+
+TEST(CommandGate, TellsARepeatedAnswerFromAStaleOne) {
+  // Lockstep, collecting tick 10; the owner's applied answer was for tick 9.
+  // The tick went out twice, so its answer to 9 came twice: a repeat. Any
+  // other old tick is stale, and the gate knows no repeat without a last answer.
+  auto g = ctx();
+  g.answered_tick = 9;
+  auto c = ok_cmd();
+  c.tick = 9;
+  EXPECT_EQ(check_command(c, g), Verdict::kRepeat);
+  c.tick = 8;
+  EXPECT_EQ(check_command(c, g), Verdict::kStaleTick);
+  c.tick = 9;
+  c.instance = 99;  // someone else's answer to tick 9 is an impostor's
+  EXPECT_EQ(check_command(c, g), Verdict::kImpostor);
+  c.instance = ok_cmd().instance;
+  EXPECT_EQ(check_command(c, ctx()), Verdict::kStaleTick);
+}

@@ -15,6 +15,7 @@ void load(YamlSection s, SimConfig& c) {
   s.get("pause_when_idle", c.pause_when_idle);
   s.get("lockstep_pipeline", c.lockstep_pipeline);
   s.get("realtime_grace", c.realtime_grace);
+  s.get("lockstep_resend_s", c.lockstep_resend_s);
   s.get("status_rate_hz", c.status_rate_hz);
   s.get("publish_per_drone_topics", c.publish_per_drone_topics);
   s.get("task_timeout_s", c.task_timeout_s);
@@ -44,6 +45,7 @@ void SimConfig::validate() const {
   check_range("sim.agent_timeout_s", agent_timeout_s, 0.1, 60.0);
   check_positive("sim.max_command_speed_mps", max_command_speed_mps);
   check_range("sim.realtime_grace", realtime_grace, 0.0, 0.9);
+  check_range("sim.lockstep_resend_s", lockstep_resend_s, 0.005, 10.0);
   check_range("sim.status_rate_hz", status_rate_hz, 0.1, 100.0);
   check_positive("sim.task_timeout_s", task_timeout_s);
   check_positive("sim.airborne_height_m", airborne_height_m);

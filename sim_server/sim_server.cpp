@@ -214,12 +214,11 @@ struct SimServer::Impl {
     counters.server_instance(instance);
     counters.mode(cfg.scenario.mode == TimeMode::kLockstep ? msg::MODE_LOCKSTEP : msg::MODE_REALTIME);
 
-    // Real time: a command that is lost is superseded one period later, so
-    // the server need not acknowledge each (dds.best_effort_streams). A
-    // lockstep tick waits for every command: reliable.
-    const Delivery commands = cfg.scenario.mode == TimeMode::kRealtime && cfg.dds.best_effort_streams
-                                  ? Delivery::kLatest
-                                  : Delivery::kProfile;
+    // dds.best_effort_streams: the server need not acknowledge each command.
+    // In real time a lost one is superseded one period later; in lockstep the
+    // tick is published again after sim.lockstep_resend_s, and the agent
+    // answers it again (run_lockstep).
+    const Delivery commands = cfg.dds.best_effort_streams ? Delivery::kLatest : Delivery::kProfile;
     if (!dds.secure()) {
       dds.reader<msg::VelocityCommand>(
           [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); }, std::nullopt,
@@ -257,6 +256,8 @@ struct SimServer::Impl {
       g.oldest_ok_tick = cfg.scenario.mode == TimeMode::kLockstep
                              ? published_tick
                              : (s.has_command ? s.command_tick : 0);
+      // An agent answers a tick published twice (run_lockstep) twice.
+      if (cfg.scenario.mode == TimeMode::kLockstep && s.live && s.has_command) g.answered_tick = s.command_tick;
     }
     Verdict v = check_command(f, g);
     switch (v) {
@@ -267,6 +268,7 @@ struct SimServer::Impl {
       case Verdict::kImpostor: counters.rejected_impostor(counters.rejected_impostor() + 1); return;
       case Verdict::kStaleTick: counters.rejected_stale_tick(counters.rejected_stale_tick() + 1); return;
       case Verdict::kFutureTick: counters.rejected_future_tick(counters.rejected_future_tick() + 1); return;
+      case Verdict::kRepeat: return;
     }
     Slot& s = slots[c.drone_id()];
     adopt(s, c.agent_instance(), c.drone_id());
@@ -830,10 +832,17 @@ struct SimServer::Impl {
         last_republish = wall_seconds();
         continue;
       }
-      // Waiting: a late joiner or a lost sample must not stall the loop forever.
-      if (wall_seconds() - last_republish > 0.25) {
+      // Waiting: a late joiner, or a sample lost on a best-effort stream (the
+      // state, or an answer), must not stall the loop. Every agent answers the
+      // tick again; a repeat of an answer already in is dropped (kRepeat).
+      // Paused, the same write tells late joiners where the swarm is.
+      if (wall_seconds() - last_republish > (paused ? 0.25 : cfg.sim.lockstep_resend_s)) {
         w_swarm.write(swarm_msg);
         last_republish = wall_seconds();
+        if (!paused) {
+          std::lock_guard<std::mutex> lock(mu);
+          counters.lockstep_resends(counters.lockstep_resends() + 1);
+        }
       }
       publish_status(false);
     }
