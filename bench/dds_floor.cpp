@@ -278,7 +278,7 @@ int main(int argc, char** argv) {
                    "(0: none, the floor)")
         ->check(CLI::NonNegativeNumber);
     app.add_flag("--best-effort-streams", g_best_effort,
-                 "read the swarm state and the commands best-effort, as a real-time swarm does "
+                 "read the swarm state and the commands best-effort, as ddswarm does by default "
                  "(dds.best_effort_streams; writers stay reliable; a lost tick is re-published after 0.25 s)");
     app.add_option("--csv", csv, "append one row per run to this CSV");
     app.add_option("--log-dir", log_dir, "responder and discovery-server logs (default: discarded)");

@@ -16,9 +16,10 @@
 #                      hosts (plain, the N drones' agents in --lockstep-hosts K agent-host
 #                      processes, default 2: the same laws, far fewer DDS round trips)
 #   --rt-time S        real-time seconds measured per N (default 60)
-#   --rt-streams best-effort|reliable   real time (per-drone processes and agent hosts): how the server reads the
-#                      commands and the agents the state (writers stay reliable)
-#                      (dds.best_effort_streams; default best-effort)
+#   --streams best-effort|reliable   every part (the floor, lockstep, real time, agent hosts, Table 1):
+#                      how the server reads the commands and the agents the state (writers stay
+#                      reliable) (dds.best_effort_streams; default best-effort, as shipped;
+#                      --rt-streams is the same option, its name before 2026-11-26)
 #   --rt-grace G       real time (both): sim.realtime_grace, the share of a period the server waits
 #                      for late answers (default 0.6; the shipped default is 0.25)
 #   --floor-time S     floor seconds measured per N (default 5)
@@ -59,7 +60,7 @@ HOSTS_SENS=10
 T1_JOBS=2
 LS_VARIANTS="plain pipelined hosts"
 LS_HOSTS_K=2
-RT_STREAMS=best-effort
+STREAMS=best-effort
 RT_GRACE=0.6
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -84,7 +85,7 @@ while [ $# -gt 0 ]; do
     --table1-jobs) T1_JOBS="$2"; shift 2 ;;
     --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; FLOOR_REPEATS=1; T1_RUNS=1; HOSTS_N=16; shift ;;
     --lockstep) LS_VARIANTS="$2"; shift 2 ;;
-    --rt-streams) RT_STREAMS="$2"; shift 2 ;;
+    --streams|--rt-streams) STREAMS="$2"; shift 2 ;;
     --rt-grace) RT_GRACE="$2"; shift 2 ;;
     -h|--help) sed -n '2,/^set -u/{/^#/p}' "$0"; exit 0 ;;
     *) echo "swarm_bench: unknown option $1" >&2; exit 2 ;;
@@ -118,6 +119,16 @@ trap 'exit 130' INT TERM
 
 echo "swarm_bench: load before start: $(cut -d' ' -f1-3 /proc/loadavg); results in $OUT"
 
+# Every part reads the per-tick streams the same way, the floor too.
+case "$STREAMS" in
+  # Explicitly: config/swarm_field.yaml, which the agent-host part flies, ships best-effort.
+  best-effort) STREAM_EXTRA=(--set dds.best_effort_streams=true); STREAM_TOOL_ARGS=(--best-effort-streams)
+               FLOOR_STREAM_ARGS=(--best-effort-streams) ;;
+  reliable) STREAM_EXTRA=(--set dds.best_effort_streams=false); STREAM_TOOL_ARGS=(--best-effort-streams=false)
+            FLOOR_STREAM_ARGS=() ;;
+  *) echo "swarm_bench: --streams must be best-effort or reliable, not '$STREAMS'" >&2; exit 2 ;;
+esac
+
 # ---------------------------------------------------------------- floor
 # floor_stats N DISCOVERY [any]: "median min max" ticks/s of the floor's good
 # runs of N with that discovery ("any": all of N's runs when it has none), or "nan".
@@ -141,11 +152,11 @@ if ! skip floor; then
   for round in $(seq "$FLOOR_REPEATS"); do
     echo "swarm_bench: floor round $round of $FLOOR_REPEATS" >&2
     "$BIN/dds_floor" --drones "$(echo $SIZES | tr ' ' ',')" --discovery both --time "$FLOOR_TIME" \
-      --explicit-ids --csv "$FLOOR_CSV" --log-dir "$OUT/floor-logs"
+      --explicit-ids --csv "$FLOOR_CSV" --log-dir "$OUT/floor-logs" "${FLOOR_STREAM_ARGS[@]}"
   done
   if [ "$FLOOR_REPEATS" -gt 1 ]; then
     echo
-    echo "== the floor over $FLOOR_REPEATS rounds: median (min-max) ticks/s; the ratios below use the median =="
+    echo "== the floor over $FLOOR_REPEATS rounds ($STREAMS state and commands): median (min-max) ticks/s; the ratios below use the median =="
     echo "| N | simple discovery | discovery server |"
     echo "|---|---|---|"
     floor_cell() { floor_stats "$1" "$2" | awk '{ print ($1 == "nan") ? "-" : sprintf("%.0f (%.0f-%.0f)", $1, $2, $3) }'; }
@@ -234,18 +245,19 @@ if ! skip lockstep; then
   for n in $SIZES; do
     for v in $LS_VARIANTS; do
       case "$v" in
-        plain) RUN_EXTRA=(); RUN_TAG="" ;;
-        pipelined) RUN_EXTRA=(--set sim.lockstep_pipeline=true); RUN_TAG="-pipelined" ;;
-        hosts) RUN_EXTRA=(--agent-hosts "$LS_HOSTS_K"); RUN_TAG="-lockstep-hosts" ;;
+        plain) RUN_EXTRA=("${STREAM_EXTRA[@]}"); RUN_TAG="" ;;
+        pipelined) RUN_EXTRA=("${STREAM_EXTRA[@]}" --set sim.lockstep_pipeline=true); RUN_TAG="-pipelined" ;;
+        hosts) RUN_EXTRA=("${STREAM_EXTRA[@]}" --agent-hosts "$LS_HOSTS_K"); RUN_TAG="-lockstep-hosts" ;;
         *) echo "swarm_bench: unknown lockstep variant '$v' (plain, pipelined, hosts)" >&2; exit 2 ;;
       esac
       echo "swarm_bench: lockstep N=$n, $v (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
+      RUN_TOOL_ARGS=("${STREAM_TOOL_ARGS[@]}")
       echo "variant=$v $(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
     done
   done
-  RUN_EXTRA=(); RUN_TAG=""
+  RUN_EXTRA=(); RUN_TAG=""; RUN_TOOL_ARGS=()
   echo
-  echo "== lockstep: ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
+  echo "== lockstep: $STREAMS state and commands; ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
   echo "| N | variant | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   while read -r l; do
@@ -262,13 +274,8 @@ fi
 
 # ---------------------------------------------------------------- real time
 # Real time, process per drone and agent hosts alike: the streams' QoS and the grace.
-case "$RT_STREAMS" in
-  best-effort) RT_EXTRA=(--set dds.best_effort_streams=true); RT_TOOL_ARGS=(--best-effort-streams) ;;
-  # Explicitly: config/swarm_field.yaml, which the agent-host part flies, ships best-effort.
-  reliable) RT_EXTRA=(--set dds.best_effort_streams=false); RT_TOOL_ARGS=(--best-effort-streams=false) ;;
-  *) echo "swarm_bench: --rt-streams must be best-effort or reliable, not '$RT_STREAMS'" >&2; exit 2 ;;
-esac
-RT_EXTRA+=(--set "sim.realtime_grace=$RT_GRACE")
+RT_EXTRA=("${STREAM_EXTRA[@]}" --set "sim.realtime_grace=$RT_GRACE")
+RT_TOOL_ARGS=("${STREAM_TOOL_ARGS[@]}")
 
 if ! skip realtime; then
   : >"$OUT/realtime.txt"
@@ -279,7 +286,7 @@ if ! skip realtime; then
   done
   RUN_EXTRA=(); RUN_TOOL_ARGS=()
   echo
-  echo "== real time: ${RT_TIME} s per N, $RT_STREAMS state and commands, realtime_grace $RT_GRACE; criteria RTF >= 0.99, command age p99 <= 2 periods, missed < 0.1 % =="
+  echo "== real time: ${RT_TIME} s per N, $STREAMS state and commands, realtime_grace $RT_GRACE; criteria RTF >= 0.99, command age p99 <= 2 periods, missed < 0.1 % =="
   echo "| N | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agents (each) | CPU discovery server | CPU probe | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | floor RTF (ticks/s / 50) | meets criteria | drone contacts | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   best=0
@@ -312,7 +319,7 @@ if ! skip hosts; then
   echo "$l" >"$OUT/hosts.txt"
   rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l")
   echo
-  echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, $RT_STREAMS state and commands, realtime_grace $RT_GRACE, ${RT_TIME} s =="
+  echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, $STREAMS state and commands, realtime_grace $RT_GRACE, ${RT_TIME} s =="
   echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | host RSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
   printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
@@ -386,6 +393,8 @@ if ! skip table1; then
   rm -rf "$T1"; mkdir -p "$T1"
   sed -e "s#^\( *scenario:\) *thesis_course.yaml#\1 $SRC/config/thesis_course.yaml#" \
       -e "s#^\( *runs_per_set:\) *[0-9]*#\1 $T1_RUNS#" "$SRC/config/table1.yaml" >"$T1/table1.yaml"
+  # Reliable streams: every set's scenario says so (the CSV's params name it too).
+  [ "$STREAMS" = reliable ] && sed -i "s#^\( *set: {.*\) }#\1, dds.best_effort_streams: false }#" "$T1/table1.yaml"
   dom=$(bench_domain)
   echo "swarm_bench: Table 1, 4 sets x $T1_RUNS runs (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
   t0=$(date +%s.%N)
@@ -395,6 +404,6 @@ if ! skip table1; then
   rc=$?
   total=$(echo "$(date +%s.%N) - $t0" | bc)
   echo
-  echo "== Table 1: 4 sets x $T1_RUNS lockstep runs of the six-drone task, $T1_JOBS at a time (exit $rc, load $(cut -d' ' -f1 /proc/loadavg)) =="
+  echo "== Table 1: 4 sets x $T1_RUNS lockstep runs of the six-drone task, $STREAMS state and commands, $T1_JOBS at a time (exit $rc, load $(cut -d' ' -f1 /proc/loadavg)) =="
   $PY "$SRC/bench/table1_split.py" "$T1/out" "$total"
 fi
