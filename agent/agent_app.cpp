@@ -145,8 +145,8 @@ struct AgentApp::Impl {
   double last_sample_wall = -1e9;
   bool server_lost = false;
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
-  std::mt19937_64 loss_rng;      // agent.state_loss: which samples to drop
-  std::uint64_t dropped = 0;     // samples dropped by agent.state_loss
+  std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
+  std::uint64_t dropped = 0;   // samples dropped by agent.state_loss
   // This tick's swarm members (live agent, not in failsafe, finite position),
   // by id: converted once per sample for every brain in the process.
   std::vector<PeerObservation> roster;
@@ -177,7 +177,8 @@ struct AgentApp::Impl {
                                                : "ddswarm-agent-host"),
         // Under DDS Security only agent-K may publish in drone K's partition
         // (one drone per secure agent process: docs/security.md).
-        w_cmd(dds.writer<msg::VelocityCommand>(cfg.dds.secure() ? drone_partition(cfg.drone_ids.at(0)) : "")),
+        w_cmd(dds.writer<msg::VelocityCommand>(
+            cfg.dds.secure() ? drone_partition(cfg.drone_ids.at(0)) : "")),
         w_status(dds.writer<msg::AgentStatus>()),
         w_ack(dds.writer<msg::MissionAck>()),
         w_beacon(dds.writer<msg::Beacon>()),
@@ -319,8 +320,9 @@ struct AgentApp::Impl {
     if (!scene) return;  // no scene yet
     if (cfg.agent.state_loss > 0 &&
         std::uniform_real_distribution<double>(0.0, 1.0)(loss_rng) < cfg.agent.state_loss) {
-      if (dropped++ == 0) spdlog::info("{}: dropping {:.1f} % of swarm states (agent.state_loss)", label,
-                                       100 * cfg.agent.state_loss);
+      if (dropped++ == 0)
+        spdlog::info("{}: dropping {:.1f} % of swarm states (agent.state_loss)", label,
+                     100 * cfg.agent.state_loss);
       return;
     }
     if (from != server || !std::isfinite(s.sim_time_s())) {  // not the server that announced the scene

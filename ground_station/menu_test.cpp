@@ -346,7 +346,8 @@ TEST(Status, CommandsAppliedAndLate) {
   EXPECT_EQ(format_commands(s), "commands: 1200 applied, 3 late (answered after their step)");
   s.lockstep_resends = 2;  // lockstep: a sample lost, the tick went out again
   EXPECT_EQ(format_commands(s),
-            "commands: 1200 applied, 3 late (answered after their step); 2 ticks published again (answers missing)");
+            "commands: 1200 applied, 3 late (answered after their step); 2 ticks published again "
+            "(answers missing)");
 }
 
 }  // namespace

@@ -24,7 +24,8 @@ Verdict check_command(const CommandFacts& c, const GateContext& g) {
   if (c.velocity.norm() > g.max_speed_mps || std::abs(c.yaw_rate) > 100.0) return Verdict::kAbsurd;
   if (g.owner_instance != 0 && c.instance != g.owner_instance) return Verdict::kImpostor;
   if (c.tick > g.published_tick) return Verdict::kFutureTick;
-  if (c.tick < g.oldest_ok_tick) return c.tick == g.answered_tick ? Verdict::kRepeat : Verdict::kStaleTick;
+  if (c.tick < g.oldest_ok_tick)
+    return c.tick == g.answered_tick ? Verdict::kRepeat : Verdict::kStaleTick;
   return Verdict::kAccept;
 }
 

@@ -16,7 +16,7 @@ enum class Verdict {
   kImpostor,     ///< another agent instance already flies this drone
   kStaleTick,    ///< older than what is being collected
   kFutureTick,   ///< for a tick not yet published
-  kRepeat,       ///< lockstep: the owner's answer again to a tick it already answered (published twice); not applied, not counted
+  kRepeat,       ///< lockstep: the owner answers a tick published twice again; dropped
 };
 
 const char* to_string(Verdict v);
@@ -35,7 +35,8 @@ struct GateContext {
   std::uint64_t oldest_ok_tick;  ///< lockstep: published_tick; realtime: last applied tick of this drone
   std::uint64_t owner_instance;  ///< the live agent instance of this drone, 0 = none
   double max_speed_mps;
-  std::optional<std::uint64_t> answered_tick = std::nullopt;  ///< lockstep: the tick the owner's applied answer was for
+  /// Lockstep: the tick the owner's applied answer was for (none: no answer yet).
+  std::optional<std::uint64_t> answered_tick = std::nullopt;
 };
 
 Verdict check_command(const CommandFacts& c, const GateContext& g);

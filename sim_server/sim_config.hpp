@@ -15,7 +15,7 @@ struct SimConfig {
   bool pause_when_idle = true;          ///< lockstep: hold the clock while every agent is idle
   bool lockstep_pipeline = false;       ///< lockstep: step physics while agents answer; commands act one tick later
   double realtime_grace = 0.25;         ///< realtime: wait up to this fraction of a period past its end for late answers
-  double lockstep_resend_s = 0.25;      ///< s wall, lockstep: publish the tick again when answers are missing this long
+  double lockstep_resend_s = 0.25;      ///< s wall, lockstep: publish again if answers are late
   double status_rate_hz = 2.0;          ///< Hz wall, SimStatus publishing
   bool publish_per_drone_topics = true; ///< also publish keyed DroneState/DistanceScan
   double task_timeout_s = 600.0;        ///< s sim time before a running task fails

@@ -257,7 +257,8 @@ struct SimServer::Impl {
                              ? published_tick
                              : (s.has_command ? s.command_tick : 0);
       // An agent answers a tick published twice (run_lockstep) twice.
-      if (cfg.scenario.mode == TimeMode::kLockstep && s.live && s.has_command) g.answered_tick = s.command_tick;
+      if (cfg.scenario.mode == TimeMode::kLockstep && s.live && s.has_command)
+        g.answered_tick = s.command_tick;
     }
     Verdict v = check_command(f, g);
     switch (v) {
@@ -268,7 +269,7 @@ struct SimServer::Impl {
       case Verdict::kImpostor: counters.rejected_impostor(counters.rejected_impostor() + 1); return;
       case Verdict::kStaleTick: counters.rejected_stale_tick(counters.rejected_stale_tick() + 1); return;
       case Verdict::kFutureTick: counters.rejected_future_tick(counters.rejected_future_tick() + 1); return;
-      case Verdict::kRepeat: return;
+      case Verdict::kRepeat: return;  // an answer already applied, to a tick published twice
     }
     Slot& s = slots[c.drone_id()];
     adopt(s, c.agent_instance(), c.drone_id());

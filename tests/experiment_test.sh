@@ -3,7 +3,8 @@
 # runs) produces a CSV, a Markdown table and plot files with the right counts.
 # Issue 8: run two at a time (--jobs 2, each on its own domain), or with each
 # run's agents in two agent-host processes (--agent-hosts 2), it gives the very
-# same results, and it says where the wall time went.
+# same results, and it says where the wall time went. Every run's server
+# stops cleanly, and no process outlives the experiment.
 source "$(dirname "$0")/lib.sh"
 out="$WORK/results"
 out2="$WORK/results2"
@@ -24,6 +25,10 @@ svgs=$(ls "$out"/plots/*.svg 2>/dev/null | wc -l)
 [ -s "$out/plots/summary.png" ] || fail "no summary plot"
 ls "$out"/runs/*.yaml | wc -l | grep -qx 4 || fail "expected 4 per-run scenarios"
 grep -Eq "wall time per run .*start-up .*flight .*teardown" "$WORK/experiment.log" || fail "no wall-time split"
+stopped=$(grep -l "ddswarm-sim: stopped at tick" "$out"/logs/*/sim.log | wc -l)
+[ "$stopped" -eq 4 ] || fail "only $stopped of 4 servers logged a clean stop"
+left=$(pgrep -f -- "$out/runs/" | wc -l)
+[ "$left" -eq 0 ] || fail "$left processes of the experiment still run after it: $(pgrep -af -- "$out/runs/")"
 timeout "$(slow 400)" "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out2" \
   --jobs 2 >"$WORK/experiment2.log" 2>&1 || { cat "$WORK/experiment2.log"; fail "experiment --jobs 2 failed"; }
 tail -3 "$WORK/experiment2.log"
