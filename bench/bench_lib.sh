@@ -50,3 +50,30 @@ bench_stop_launch() {
   wait "$LAUNCH_PID" 2>/dev/null
   LAUNCH_PID=""
 }
+
+# bench_swarm_options DEFAULT_SECS ARGS...: the options every one-swarm bench
+# takes. Sets BIN (--bin, default build/default/bin), MODE (--mode, default
+# lockstep), SECS (--time), OUT (--out, default empty) and leaves the other
+# arguments, in order, in BENCH_REST for the script's own.
+bench_swarm_options() {
+  BIN="$SRC/build/default/bin"; MODE=lockstep; SECS="$1"; OUT=""; BENCH_REST=()
+  shift
+  while [ $# -gt 0 ]; do
+    case "$1" in
+      --bin) BIN="$2"; shift 2 ;;
+      --mode) MODE="$2"; shift 2 ;;
+      --time) SECS="$2"; shift 2 ;;
+      --out) OUT="$2"; shift 2 ;;
+      *) BENCH_REST+=("$1"); shift ;;
+    esac
+  done
+}
+
+# bench_swarm_pids: after bench_hold_swarm and 2 s of ticking, sets SIM_PID and
+# AGENT_PID (drone 1's agent); returns 1 when either is missing.
+bench_swarm_pids() {
+  sleep 2
+  SIM_PID=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
+  AGENT_PID=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
+  [ -n "$SIM_PID" ] && [ -n "$AGENT_PID" ]
+}

@@ -6,26 +6,19 @@
 # Usage: bench/profile_swarm.sh [--bin DIR] [--mode lockstep|realtime] [--time S] [--out DIR] N...
 set -u
 SRC="$(cd "$(dirname "$0")/.." && pwd)"
-BIN="$SRC/build/default/bin"
-MODE=lockstep
-SECS=8
-OUT=""
+source "$SRC/bench/bench_lib.sh"
+bench_swarm_options 8 "$@"
 SIZES=()
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --bin) BIN="$2"; shift 2 ;;
-    --mode) MODE="$2"; shift 2 ;;
-    --time) SECS="$2"; shift 2 ;;
-    --out) OUT="$2"; shift 2 ;;
+for a in "${BENCH_REST[@]}"; do
+  case "$a" in
     -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
-    *) SIZES+=("$1"); shift ;;
+    *) SIZES+=("$a") ;;
   esac
 done
 [ ${#SIZES[@]} -gt 0 ] || SIZES=(6 64 128)
 command -v perf >/dev/null || { echo "profile_swarm: perf not installed (Debian linux-perf)" >&2; exit 2; }
 [ -n "$OUT" ] || OUT="$(mktemp -d /tmp/ddswarm-profile.XXXXXX)"
 mkdir -p "$OUT"
-source "$SRC/bench/bench_lib.sh"
 SCENARIO="$OUT/profile_scenario.yaml"
 bench_scenario "$SCENARIO"
 trap bench_stop_launch EXIT
@@ -47,9 +40,8 @@ for n in "${SIZES[@]}"; do
   log="$OUT/$MODE-$n"
   mkdir -p "$log"
   bench_hold_swarm "$MODE" "$n" "$log" "$SCENARIO" || { bench_stop_launch; continue; }
-  sleep 2
-  sim=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
-  agent=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
+  bench_swarm_pids || { echo "N=$n: server or agent 1 not found"; bench_stop_launch; continue; }
+  sim=$SIM_PID agent=$AGENT_PID
   read -r su0 ss0 < <(cpu_split "$sim"); read -r au0 as0 < <(cpu_split "$agent")
   perf record -q -e cpu-clock -F 999 -p "$sim" -o "$log/sim.perf" -- sleep "$SECS" >/dev/null 2>&1 &
   p1=$!

@@ -8,36 +8,27 @@
 # Usage: bench/thread_wakes.sh [--bin DIR] [--mode lockstep|realtime] [--time S] [--out DIR] [--stacks] N
 set -u
 SRC="$(cd "$(dirname "$0")/.." && pwd)"
-BIN="$SRC/build/default/bin"
-MODE=lockstep
-SECS=5
-OUT=""
+source "$SRC/bench/bench_lib.sh"
+bench_swarm_options 5 "$@"
 STACKS=0
 N=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --bin) BIN="$2"; shift 2 ;;
-    --mode) MODE="$2"; shift 2 ;;
-    --time) SECS="$2"; shift 2 ;;
-    --out) OUT="$2"; shift 2 ;;
-    --stacks) STACKS=1; shift ;;
+for a in "${BENCH_REST[@]}"; do
+  case "$a" in
+    --stacks) STACKS=1 ;;
     -h|--help) sed -n '2,8p' "$0"; exit 0 ;;
-    *) N="$1"; shift ;;
+    *) N="$a" ;;
   esac
 done
 [ -n "$N" ] || { echo "thread_wakes: give N, the number of agent processes" >&2; exit 2; }
 [ -n "$OUT" ] || OUT="$(mktemp -d /tmp/ddswarm-wakes.XXXXXX)"
 mkdir -p "$OUT"
-source "$SRC/bench/bench_lib.sh"
 SCENARIO="$OUT/scenario.yaml"
 bench_scenario "$SCENARIO"
 trap bench_stop_launch EXIT
 trap 'exit 130' INT TERM
 bench_hold_swarm "$MODE" "$N" "$OUT" "$SCENARIO" >&2 || exit 1
-sleep 2
-sim=$(pgrep -P "$LAUNCH_PID" -x ddswarm-sim | head -1)
-agent=$(pgrep -P "$LAUNCH_PID" -f "ddswarm-agent --id 1 " | head -1)
-[ -n "$sim" ] && [ -n "$agent" ] || { echo "thread_wakes: server or agent 1 not found" >&2; exit 1; }
+bench_swarm_pids || { echo "thread_wakes: server or agent 1 not found" >&2; exit 1; }
+sim=$SIM_PID agent=$AGENT_PID
 
 snap() {  # snap PID -> "tid voluntary involuntary cpu_ticks" per thread
   for t in /proc/"$1"/task/*; do
