@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 #include <random>
+#include <utility>
 #include <deque>
 #include <map>
 #include <set>
@@ -146,7 +147,7 @@ struct AgentApp::Impl {
   bool server_lost = false;
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
   std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
-  std::uint64_t dropped = 0;   // samples dropped by agent.state_loss
+  bool loss_logged = false;    // agent.state_loss said so in the log
   // This tick's swarm members (live agent, not in failsafe, finite position),
   // by id: converted once per sample for every brain in the process.
   std::vector<PeerObservation> roster;
@@ -320,7 +321,7 @@ struct AgentApp::Impl {
     if (!scene) return;  // no scene yet
     if (cfg.agent.state_loss > 0 &&
         std::uniform_real_distribution<double>(0.0, 1.0)(loss_rng) < cfg.agent.state_loss) {
-      if (dropped++ == 0)
+      if (!std::exchange(loss_logged, true))
         spdlog::info("{}: dropping {:.1f} % of swarm states (agent.state_loss)", label,
                      100 * cfg.agent.state_loss);
       return;
