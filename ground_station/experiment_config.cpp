@@ -158,6 +158,35 @@ YAML::Node apply_overrides(YAML::Node scenario,
   return out;
 }
 
+std::map<std::string, YAML::Node> parse_set_options(const std::vector<std::string>& texts,
+                                                    const std::string& option) {
+  std::map<std::string, YAML::Node> out;
+  for (const auto& kv : texts) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) throw FieldError(option, kv, "must be key.path=value");
+    try {
+      out[kv.substr(0, eq)] = YAML::Load(kv.substr(eq + 1));
+    } catch (const YAML::Exception& e) {
+      throw FieldError(option, kv, "value is not YAML: " + e.msg);
+    }
+  }
+  return out;
+}
+
+void override_every_set(ExperimentConfig& c, const std::map<std::string, YAML::Node>& overrides) {
+  for (auto& set : c.sets) {
+    for (const auto& [key, value] : overrides) {
+      // The command line wins over the set's value for the key and for
+      // anything under or above it (validate() rejects a key and its child).
+      std::erase_if(set.overrides, [&](const auto& o) {
+        return o.first == key || o.first.starts_with(key + ".") || key.starts_with(o.first + ".");
+      });
+      set.overrides[key] = YAML::Clone(value);
+    }
+  }
+  c.validate();
+}
+
 YAML::Node scenario_for_set(const ExperimentConfig& c, std::size_t set_index) {
   const ExperimentSet& set = c.sets.at(set_index);
   const YamlDocument doc = YamlDocument::load_file(c.scenario_path);

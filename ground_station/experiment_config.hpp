@@ -69,6 +69,17 @@ ExperimentConfig parse_experiment(const std::string& text, const std::string& fi
 /// key when a path is malformed or walks through a value that is not a mapping.
 YAML::Node apply_overrides(YAML::Node scenario, const std::map<std::string, YAML::Node>& overrides);
 
+/// Command-line overrides, each "key.path=value" (ddswarm-launch --set and
+/// ddswarm-gs experiment --set); the value is YAML. Throws FieldError(option,
+/// text, ...) for text without '=' or with nothing before it.
+std::map<std::string, YAML::Node> parse_set_options(const std::vector<std::string>& texts,
+                                                    const std::string& option = "--set");
+
+/// Writes overrides into every set of c, over the set's own value for the same
+/// key (e.g. `experiment --set sim.physics_rate_hz=250` flies every set at
+/// 250 Hz); each run's CSV row records them with the set's. Validates c again.
+void override_every_set(ExperimentConfig& c, const std::map<std::string, YAML::Node>& overrides);
+
 /// The scenario of set set_index: the scenario file with the set's overrides
 /// applied. Throws ConfigError (unreadable scenario, bad override) or
 /// std::out_of_range (set_index).

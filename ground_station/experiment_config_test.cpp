@@ -224,5 +224,47 @@ TEST(ApplyOverrides, ScenarioForSetReadsTheScenarioFile) {
   fs::remove_all(dir);
 }
 
+// `ddswarm-gs experiment --set`: one value for every set, over the set's own.
+TEST(ExperimentConfig, CommandLineOverridesWinInEverySet) {
+  auto c = parse_experiment(R"(experiment:
+  scenario: course.yaml
+  sets:
+    - name: A
+      set: { agent.inter_distance_m: 4, agent.sensor_function.type: fs1 }
+    - name: B
+      set: { agent.sensor_function: { type: fs2 } }
+)",
+                            "/exp/table.yaml");
+  override_every_set(
+      c, parse_set_options({"sim.physics_rate_hz=250", "agent.sensor_function.type=fs2"}));
+  for (const auto& set : c.sets) {
+    SCOPED_TRACE(set.name);
+    EXPECT_EQ(set.overrides.at("sim.physics_rate_hz").as<int>(), 250);
+    EXPECT_EQ(set.overrides.at("agent.sensor_function.type").as<std::string>(), "fs2");
+    EXPECT_EQ(set.overrides.count("agent.sensor_function"), 0u);  // its parent gave way
+  }
+  EXPECT_EQ(c.sets[0].overrides.at("agent.inter_distance_m").as<double>(), 4);
+  EXPECT_EQ(c.sets[1].overrides.size(), 2u);
+}
+
+TEST(ExperimentConfig, RejectsASetOptionWithoutAKey) {
+  for (const char* bad : {"sim.physics_rate_hz", "=250", ""}) {
+    SCOPED_TRACE(bad);
+    try {
+      parse_set_options({"a.b=1", bad});
+      FAIL();
+    } catch (const FieldError& e) {
+      EXPECT_EQ(std::string(e.what()), "--set = " + std::string(bad) + ": must be key.path=value");
+    }
+  }
+  try {
+    parse_set_options({"a.b=[1, 2"});
+    FAIL();
+  } catch (const FieldError& e) {
+    EXPECT_NE(std::string(e.what()).find("--set = a.b=[1, 2: value is not YAML"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace ddswarm::gs

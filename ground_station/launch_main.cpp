@@ -130,14 +130,7 @@ int main(int argc, char** argv) {
       scenario = path;
     };
     if (!sets.empty()) {
-      std::map<std::string, YAML::Node> overrides;
-      for (const auto& kv : sets) {
-        auto eq = kv.find('=');
-        if (eq == std::string::npos || eq == 0)
-          throw FieldError("--set", kv, "must be key.path=value");
-        overrides[kv.substr(0, eq)] = YAML::Load(kv.substr(eq + 1));
-      }
-      derive(overrides, "--set overrides");
+      derive(parse_set_options(sets), "--set overrides");
     }
     if (app.count("--participant-id"))
       throw FieldError("--participant-id", app.get_option("--participant-id")->as<std::string>(),

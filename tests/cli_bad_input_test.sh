@@ -35,6 +35,10 @@ expect_usage_error "gs takeoff --altitude 1e400" "1e400" gs takeoff --altitude 1
 expect_usage_error "gs follow --leader 99999999999" "99999999999" gs follow --leader 99999999999
 expect_usage_error "gs wait-agents --timeout nan" "nan" gs wait-agents --timeout nan
 expect_usage_error "gs trace --duration inf" "inf" gs trace --out "$WORK/t.csv" --duration inf
+expect_usage_error "gs experiment --set without =" "--set = sim.physics_rate_hz: must be key.path=value" \
+  gs experiment "$SRC/config/table1.yaml" --out "$WORK/exp" --set sim.physics_rate_hz
+expect_usage_error "launch --set bad YAML" "--set = sim.physics_rate_hz=[1: value is not YAML" \
+  timeout 5 "$BIN/ddswarm-launch" "$SRC/config/thesis_course.yaml" --domain "$DOMAIN" --set "sim.physics_rate_hz=[1"
 expect_usage_error "gs no-such-subcommand" "no-such-subcommand" gs no-such-subcommand
 expect_usage_error "sim --duration nan" "nan" timeout 5 "$BIN/ddswarm-sim" --scenario "$SRC/tests/scenarios/one_drone.yaml" --domain "$DOMAIN" --duration nan
 expect_usage_error "agent --duration -1" "-1" timeout 5 "$BIN/ddswarm-agent" --id 0 --domain "$DOMAIN" --duration -1
