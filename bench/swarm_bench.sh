@@ -104,6 +104,15 @@ PY=/usr/bin/python3
 source "$SRC/bench/bench_lib.sh"
 SCENARIO="$OUT/bench_scenario.yaml"
 bench_scenario "$SCENARIO"
+# The rates the swarms fly (the scenario's, or the last --set of them), for the tables' titles.
+set_value() {  # set_value KEY -> the value of the last --set KEY=..., or the scenario's sim.KEY
+  local v="" a
+  for a in "${SETS[@]}"; do [[ "$a" == "sim.$1="* ]] && v="${a#*=}"; done
+  [ -n "$v" ] || v=$(sed -n "s/^  $1: *\([0-9.]*\).*/\1/p" "$SCENARIO")
+  echo "$v"
+}
+PHYS_HZ=$(set_value physics_rate_hz)
+SENS_HZ=$(set_value sensor_rate_hz)
 
 LAUNCH_PID=""
 cleanup() {
@@ -257,7 +266,7 @@ if ! skip lockstep; then
   done
   RUN_EXTRA=(); RUN_TAG=""; RUN_TOOL_ARGS=()
   echo
-  echo "== lockstep: $STREAMS state and commands; ticks/s with physics (1 kHz) and sensors (8 rays, 50 Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
+  echo "== lockstep: $STREAMS state and commands; ticks/s with physics ($PHYS_HZ Hz) and sensors (8 rays, $SENS_HZ Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
   echo "| N | variant | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
   echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   while read -r l; do

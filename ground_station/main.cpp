@@ -1,9 +1,9 @@
 // ddswarm-gs: the ground station. Without a subcommand it opens the
 // interactive console (thesis Fig. 9); subcommands script the same actions.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -13,6 +13,7 @@
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
 #include "common/process.hpp"
+#include "ground_station/compare.hpp"
 #include "ground_station/dds_commander.hpp"
 #include "ground_station/experiment.hpp"
 #include "ground_station/gs_app.hpp"
@@ -83,6 +84,38 @@ bool finite_all(std::initializer_list<double> v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
   return true;
+}
+
+/// `ddswarm-gs compare`: each CSV after the first against the first.
+int compare_experiments(const std::vector<std::string>& files, std::vector<std::string> labels,
+                        const std::string& plot_dir, bool fail_if_different) {
+  if (files.size() < 2)
+    throw FieldError("compare", std::to_string(files.size()) + " file", "needs 2 CSVs or more");
+  if (labels.empty()) labels = files;
+  if (labels.size() != files.size())
+    throw FieldError("--labels", std::to_string(labels.size()) + " labels",
+                     "needs one per CSV (" + std::to_string(files.size()) + ")");
+  std::vector<std::vector<RunRecord>> runs;
+  for (const auto& f : files) {
+    try {
+      runs.push_back(read_csv(f));
+    } catch (const std::runtime_error& e) {
+      throw ConfigError(e.what());
+    }
+  }
+  bool different = false;
+  for (std::size_t i = 1; i < files.size(); ++i) {
+    const auto sets = compare_sets(runs[0], runs[i]);
+    std::printf("%s against %s:\n\n%s\n", labels[i].c_str(), labels[0].c_str(),
+                comparison_table(sets, labels[0], labels[i]).c_str());
+    for (const auto& c : sets) different = different || c.significant;
+  }
+  if (!plot_dir.empty()) {
+    std::vector<std::vector<SetSummary>> sums;
+    for (const auto& r : runs) sums.push_back(summarize(r));
+    std::printf("plot: %s\n", write_comparison_plot(sums, labels, plot_dir, "compare").c_str());
+  }
+  return fail_if_different && different ? 1 : 0;
 }
 
 }  // namespace
@@ -176,12 +209,37 @@ int main(int argc, char** argv) {
                            "each run's agents in K ddswarm-agent --ids processes instead of one per drone "
                            "(the same lockstep results, faster for large swarms)")
         ->check(CLI::Range(0, 1024));
+    std::vector<std::string> exp_sets;
+    experiment->add_option("--set", exp_sets,
+                           "override a scenario key in every set, over the set's own value, e.g. "
+                           "--set sim.physics_rate_hz=250 (repeatable; recorded in the CSV)");
+
+    auto* compare = app.add_subcommand(
+        "compare",
+        "compare experiment CSVs set by set: means, Welch's t at 5 %, same-seed runs (no DDS)");
+    std::vector<std::string> cmp_files, cmp_labels;
+    std::string cmp_plot;
+    bool cmp_fail = false;
+    compare
+        ->add_option("files", cmp_files,
+                     "the base experiment's CSV, then one or more to compare with it")
+        ->required()
+        ->check(CLI::ExistingFile);
+    compare
+        ->add_option("--labels", cmp_labels,
+                     "a name per CSV for the table and plot (default: the paths)")
+        ->delimiter(',');
+    compare->add_option("--plot", cmp_plot,
+                        "write DIR/compare.png and .svg: every CSV's mean and spread per set");
+    compare->add_flag("--fail-if-different", cmp_fail,
+                      "exit 1 when a set's mean differs at the 5 % level");
 
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
       return app.exit(e) == 0 ? 0 : 2;
     }
+    if (*compare) return compare_experiments(cmp_files, cmp_labels, cmp_plot, cmp_fail);
     spdlog::set_level(spdlog::level::warn);
     auto file = load_gs_config(config);
     merge_cli(file.dds, dds_cli, app);
@@ -199,6 +257,7 @@ int main(int argc, char** argv) {
     }
     if (*experiment) {
       auto exp = load_experiment_file(exp_file);
+      if (!exp_sets.empty()) override_every_set(exp, parse_set_options(exp_sets));
       ExperimentOptions opt;
       opt.out_dir = out_dir;
       opt.dds = file.dds;

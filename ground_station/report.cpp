@@ -272,15 +272,6 @@ std::vector<std::pair<std::string, std::vector<const RunRecord*>>> group_by_set(
   return sets;
 }
 
-std::string gnuplot_string(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += '\'';
-    out += (c == '\n' || c == '\r') ? ' ' : c;
-  }
-  return out + "'";
-}
-
 std::string read_text(const std::string& path) {
   std::ifstream in(path);
   std::stringstream ss;
@@ -642,21 +633,39 @@ std::string write_summary_plot(const std::vector<SetSummary>& sets, const std::s
   const std::string base = dir + "/summary";
   write_text(base + ".dat", dat.str());
   std::ostringstream gp;
-  gp << "data = " << gnuplot_string(base + ".dat") << "\n"
+  gp << "data = " << gnuplot_string("summary.dat") << "\n"  // gnuplot runs in dir
      << "set title 'Task time per set (mean and standard deviation)'\n"
      << "set ylabel 'Time to complete [s]'\nset yrange [0:*]\nset grid ytics\n"
      << "set style fill solid 0.6 border -1\nset boxwidth 0.6\nset xtics rotate by -30\n"
      << "set xrange [-0.6:" << sets.size() - 0.4 << "]\nunset key\n"
      << "plot data using 1:2:xtic(5) with boxes lc rgb '#1f77b4', \\\n"
      << "     data using 1:2:3 with yerrorbars pt 0 lc rgb 'black', \\\n"
-     << "     data using 1:($4 > 0 ? $2 : 1/0):(sprintf('%d failed', $4)) with labels offset 0,1.2\n";
+     << "     data using 1:($4 > 0 ? $2 : 1/0):(sprintf('%d failed', $4)) with labels offset "
+        "0,1.2\n";
+  return render_gnuplot(dir, "summary", gp.str(), 900, 500);
+}
+
+std::string gnuplot_string(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'') out += '\'';
+    out += (c == '\n' || c == '\r') ? ' ' : c;
+  }
+  return out + "'";
+}
+
+std::string render_gnuplot(const std::string& dir, const std::string& stem, const std::string& plot,
+                           int width, int height) {
+  // gnuplot runs in dir: the script is named by its absolute path, its outputs relative to dir.
+  const std::string base = fs::absolute(dir).string() + "/" + stem;
+  const std::string size = std::to_string(width) + "," + std::to_string(height);
   std::ostringstream script;
   script << "if (strstrt(GPVAL_TERMINALS, ' pngcairo ') > 0) {\n"
-         << "  set terminal pngcairo size 900,500 noenhanced font 'sans,10'\n"
-         << "} else {\n  set terminal png size 900,500 noenhanced\n}\n"
-         << "set output " << gnuplot_string(base + ".png") << "\n"
-         << gp.str() << "set terminal svg size 900,500 noenhanced\n"
-         << "set output " << gnuplot_string(base + ".svg") << "\nreplot\nunset output\n";
+         << "  set terminal pngcairo size " << size << " noenhanced font 'sans,10'\n"
+         << "} else {\n  set terminal png size " << size << " noenhanced\n}\n"
+         << "set output " << gnuplot_string(stem + ".png") << "\n"
+         << plot << "set terminal svg size " << size << " noenhanced\n"
+         << "set output " << gnuplot_string(stem + ".svg") << "\nreplot\nunset output\n";
   write_text(base + ".gp", script.str());
   run_gnuplot(dir, base + ".gp", base + ".log");
   std::error_code rm;

@@ -96,6 +96,16 @@ std::string plot_stem(const std::string& set_name);
 /// std::runtime_error when gnuplot fails. write_plots() calls it for 2+ sets.
 std::string write_summary_plot(const std::vector<SetSummary>& sets, const std::string& dir);
 
+/// s as a gnuplot single-quoted string (quotes doubled, line breaks as spaces).
+std::string gnuplot_string(const std::string& s);
+
+/// Writes <dir>/<stem>.gp: `plot` (gnuplot commands that draw one figure)
+/// rendered to <stem>.png (pngcairo, or png without cairo) and <stem>.svg at
+/// width x height; runs gnuplot in dir. Returns the png path; throws
+/// std::runtime_error when gnuplot is missing, fails or writes no png.
+std::string render_gnuplot(const std::string& dir, const std::string& stem, const std::string& plot,
+                           int width, int height);
+
 std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
                                      const std::string& out_dir);
 
