@@ -127,7 +127,7 @@ std::string comparison_table(const std::vector<SetComparison>& sets, const std::
                              const std::string& other_label) {
   std::ostringstream md;
   md << "| set | " << md_text(base_label) << " | " << md_text(other_label)
-     << " | difference | Welch t (df) | at 5 % | same seed: mean (max) |difference| "
+     << " | difference | Welch t (df) | at 5 % | same seed: mean (max) absolute difference "
         "| collisions per run | min inter-drone distance |\n"
      << "|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : sets) {

@@ -35,10 +35,22 @@ tail -3 "$WORK/experiment2.log"
 results() { awk -F, 'NR > 1 { print $1, $2, $3, $9, $11, $13, $14, $15, $16 }' "$1" | sort; }
 diff <(results "$out/short.csv") <(results "$out2/short.csv") || fail "two at a time gave other results"
 # The drones' agents in two agent-host processes: the very same results too.
+# --set reaches every set's runs (a failsafe delay no run needs: results stay).
 out3="$WORK/results3"
 timeout "$(slow 400)" "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$out3" \
-  --agent-hosts 2 >"$WORK/experiment3.log" 2>&1 || { cat "$WORK/experiment3.log"; fail "experiment --agent-hosts 2 failed"; }
+  --agent-hosts 2 --set sim.failsafe_land_after_s=7 >"$WORK/experiment3.log" 2>&1 ||
+  { cat "$WORK/experiment3.log"; fail "experiment --agent-hosts 2 failed"; }
 tail -3 "$WORK/experiment3.log"
 ls "$out3"/logs/*/ | grep -q "agent_host_1" || fail "no agent-host logs: were the agents one process per drone?"
 diff <(results "$out/short.csv") <(results "$out3/short.csv") || fail "agent hosts gave other results"
+[ "$(grep -l "failsafe_land_after_s: 7" "$out3"/runs/*.yaml | wc -l)" -eq 4 ] || fail "--set did not reach all 4 runs"
+[ "$(grep -c "sim.failsafe_land_after_s=7" "$out3/short.csv")" -eq 4 ] || fail "the CSV does not record --set"
+# compare: the same experiment run two ways is the same, set by set, and plotted.
+"$BIN/ddswarm-gs" compare "$out/short.csv" "$out3/short.csv" --labels "one process per drone,agent hosts" \
+  --plot "$WORK/compare" --fail-if-different >"$WORK/compare.md" 2>&1 ||
+  { cat "$WORK/compare.md"; fail "compare found a difference, or failed"; }
+cat "$WORK/compare.md"
+[ "$(grep -cE "^\| (Slow|Fast) \|.*\| same \| 0.00 \(0.00\) s, 2 runs \|" "$WORK/compare.md")" -eq 2 ] ||
+  fail "compare did not call both sets the same with 2 identical same-seed runs"
+[ -s "$WORK/compare/compare.png" ] || fail "compare wrote no plot"
 echo PASS
