@@ -1,8 +1,9 @@
 // ddswarm-agent: the brain of one drone, a process of its own; or, with
 // --ids, an agent host flying many drones' independent brains in one process.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
+#include <cstdio>
 #include <optional>
 
 #include "agent/agent_app.hpp"
@@ -31,12 +32,17 @@ int main(int argc, char** argv) {
     app.add_option("--duplicate-probe", probe_s,
                    "s to listen for another agent flying the same drone before flying (0 = trust the launcher)")
         ->check(ddswarm::finite_range(0.0, 60.0));
+    bool check = false;
+    app.add_flag("--check", check,
+                 "check the scenario as this agent would read it (drone 0 without --id), print one "
+                 "line and exit (0: valid, 2: the error); no DDS");
     ddswarm::add_dds_options(app, dds_cli);
     try {
       app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
       return app.exit(e) == 0 ? 0 : 2;
     }
+    if (check && !id && ids_text.empty()) id = 0;
     if (!id && ids_text.empty()) {
       std::fprintf(stderr, "ddswarm-agent: error: --id or --ids is required\n");
       return 2;
@@ -62,6 +68,10 @@ int main(int argc, char** argv) {
     ddswarm::default_security_role(
         cfg.dds, cfg.drone_ids.size() == 1 ? "agent-" + std::to_string(cfg.drone_ids[0]) : "agent-host");
     ddswarm::validate_with_overrides(config, [&] { cfg.validate(); });
+    if (check) {
+      std::printf("ddswarm-agent: %s: the agent's sections are valid\n", config.c_str());
+      return 0;
+    }
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
     ddswarm::install_stop_signals();
     ddswarm::install_rejoin_signal();

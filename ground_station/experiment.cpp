@@ -2,16 +2,19 @@
 
 #include <fmt/format.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <thread>
-#include <atomic>
 #include <mutex>
 #include <optional>
+#include <sstream>
+#include <thread>
 #include <vector>
 
+#include "common/config_error.hpp"
 #include "common/process.hpp"
+#include "ground_station/gs_app.hpp"
 #include "ground_station/launcher.hpp"
 #include "ground_station/report.hpp"
 
@@ -97,6 +100,44 @@ struct RunTimes {
 
 }  // namespace
 
+namespace {
+
+/// A bad key or value in a set (or a --set) fails each of its runs at
+/// start-up, after a minute's wait for a swarm that never comes: the ground
+/// station, the server and an agent read each set's first run file as they
+/// will, first. Throws ConfigError "set 'S': <the reader's one-line error>".
+void check_sets(const ExperimentConfig& cfg, const std::vector<RunPlan>& plans,
+                const std::string& bin) {
+  for (const auto& p : plans) {
+    if (p.k != 0) continue;
+    const std::string set = "set '" + cfg.sets[p.set].name + "': ";
+    try {
+      (void)load_gs_config(p.scenario_file);
+    } catch (const std::exception& e) {
+      throw ConfigError(set + e.what());
+    }
+    for (const auto& argv :
+         {std::vector<std::string>{bin + "/ddswarm-sim", "--check", "--scenario", p.scenario_file},
+          std::vector<std::string>{bin + "/ddswarm-agent", "--check", "--config",
+                                   p.scenario_file}}) {
+      std::string said;
+      const ChildExit e = run_to_end({argv[0], argv}, said);
+      if (e.exit_code == 0) continue;
+      // The reader's own error line ("ddswarm-sim: error: FILE:LINE: key = value: reason").
+      std::string line;
+      std::istringstream lines(said);
+      for (std::string l; std::getline(lines, l);)
+        if (l.find("error") != std::string::npos) {
+          line = l;
+          break;
+        }
+      throw ConfigError(set + (line.empty() ? e.describe() + ": " + said : line));
+    }
+  }
+}
+
+}  // namespace
+
 int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, std::ostream& out) {
   const std::string bin = opt.bin_dir.empty() ? Launcher::self_dir() : opt.bin_dir;
   fs::create_directories(opt.out_dir + "/runs");
@@ -144,6 +185,7 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
     }
   }
 
+  check_sets(cfg, plans, bin);
   out << fmt::format("experiment '{}': {} sets x {} runs, {} mode, {} at a time, results in {}\n", cfg.name,
                      cfg.sets.size(), cfg.runs_per_set, cfg.mode, jobs, opt.out_dir);
   std::mutex mu;  // out, the counters and the records below

@@ -33,6 +33,11 @@ struct ChildExit {
   std::string describe() const;  ///< "agent 3 (pid 1234) exited with code 1" / "was killed by SIGKILL"
 };
 
+/// Runs spec to its end and returns how it ended; output gets its stdout and
+/// stderr together. For quick checks (`ddswarm-sim --check`): no timeout, no
+/// supervision. Throws std::runtime_error when it cannot start.
+ChildExit run_to_end(const ChildSpec& spec, std::string& output);
+
 class Launcher {
  public:
   /// log_dir: when set, each child's output goes to <log_dir>/<name>.log

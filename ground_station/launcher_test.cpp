@@ -35,6 +35,19 @@ TEST(Launcher, ReportsWhichChildDiedAndWhy) {
   EXPECT_NE(exits[0].describe().find("killed by SIGKILL"), std::string::npos);
 }
 
+// The experiment's set check: a program's whole output and its exit code.
+TEST(Launcher, RunToEndCollectsOutputAndExitCode) {
+  std::string out;
+  const ChildExit e =
+      run_to_end({"sh", {"/bin/sh", "-c", "echo said; echo 'error: bad' >&2; exit 3"}}, out);
+  EXPECT_EQ(e.exit_code, 3);
+  EXPECT_EQ(e.signal, 0);
+  EXPECT_EQ(out, "said\nerror: bad\n");
+  EXPECT_EQ(run_to_end({"true", {"/bin/true"}}, out).exit_code, 0);
+  EXPECT_EQ(out, "");
+  EXPECT_THROW(run_to_end({"none", {"/no/such/program"}}, out), std::runtime_error);
+}
+
 TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
   // As fast-discovery-server 2.9 prints its errors, colours and all.
   auto logged = [](const std::string& message, const std::string& function) {

@@ -1,7 +1,8 @@
 // ddswarm-sim: the simulation server.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
+#include <cstdio>
 #include <optional>
 
 #include "common/cli_checks.hpp"
@@ -25,6 +26,11 @@ int main(int argc, char** argv) {
     app.add_option("--seed", seed, "override scenario.seed");
     app.add_option("--drones", drones, "override scenario.drones");
     app.add_option("--mode", mode, "override scenario.mode")->check(CLI::IsMember({"realtime", "lockstep"}));
+    bool check = false;
+    app.add_flag(
+        "--check", check,
+        "check the scenario as this server would read it, print one line and exit (0: valid, "
+        "2: the error); no DDS");
     ddswarm::add_dds_options(app, dds_cli);
     try {
       app.parse(argc, argv);
@@ -38,6 +44,10 @@ int main(int argc, char** argv) {
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
     ddswarm::default_security_role(cfg.dds, "server");
     ddswarm::validate_with_overrides(scenario, [&] { cfg.validate(); });
+    if (check) {
+      std::printf("ddswarm-sim: %s: the server's sections are valid\n", scenario.c_str());
+      return 0;
+    }
     ddswarm::install_stop_signals();
     // Segments that crashed runs left in /dev/shm pile up until the next run
     // cannot map its own: clear the zombies (never a live process's) first.

@@ -37,6 +37,20 @@ expect_usage_error "gs wait-agents --timeout nan" "nan" gs wait-agents --timeout
 expect_usage_error "gs trace --duration inf" "inf" gs trace --out "$WORK/t.csv" --duration inf
 expect_usage_error "gs experiment --set without =" "--set = sim.physics_rate_hz: must be key.path=value" \
   gs experiment "$SRC/config/table1.yaml" --out "$WORK/exp" --set sim.physics_rate_hz
+# A bad value in an experiment's set is found before any run, in well under a second, not after
+# each run's wait for a swarm whose server exited at once (4 runs took 4 minutes before).
+expect_usage_error "gs experiment --set a bad rate" "set 'Slow': ddswarm-sim: error: $WORK/exp-bad/runs/Slow-00.yaml:8: sim.control_rate_hz = 70: must divide" \
+  gs experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$WORK/exp-bad" --set sim.control_rate_hz=70
+expect_usage_error "gs experiment --set an unknown agent key" "set 'Slow': ddswarm-agent: error:" \
+  gs experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$WORK/exp-bad" --set agent.no_such_key=1
+[ ! -e "$WORK/exp-bad/short.csv" ] || problems+=("experiment with a bad set ran runs anyway")
+for b in sim agent; do
+  flag=--scenario; [ $b = agent ] && flag=--config
+  out=$(timeout 5 "$BIN/ddswarm-$b" --check $flag "$SRC/config/thesis_course.yaml" 2>&1)
+  rc=$?
+  echo "ddswarm-$b --check thesis_course.yaml: exit $rc: $out"
+  [ $rc -eq 0 ] && [[ "$out" == *"sections are valid"* ]] || problems+=("ddswarm-$b --check rejected a valid scenario")
+done
 expect_usage_error "launch --set bad YAML" "--set = sim.physics_rate_hz=[1: value is not YAML" \
   timeout 5 "$BIN/ddswarm-launch" "$SRC/config/thesis_course.yaml" --domain "$DOMAIN" --set "sim.physics_rate_hz=[1"
 expect_usage_error "gs no-such-subcommand" "no-such-subcommand" gs no-such-subcommand
