@@ -613,7 +613,10 @@ std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
     fs::remove(base + ".log", rm);
     pngs.push_back(base + ".png");
   }
-  if (summaries.size() > 1) pngs.push_back(write_summary_plot(summaries, dir));
+  // The summary needs a mean to draw: with every run failed, gnuplot finds no point at all.
+  const bool any_mean = std::any_of(summaries.begin(), summaries.end(),
+                                    [](const SetSummary& s) { return std::isfinite(s.mean_time_s); });
+  if (summaries.size() > 1 && any_mean) pngs.push_back(write_summary_plot(summaries, dir));
   return pngs;
 }
 

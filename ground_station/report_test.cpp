@@ -294,6 +294,18 @@ TEST_F(ReportTest, PlotsEveryRunOfEachSetAsPngAndSvg) {
       << dat;
 }
 
+// Every run failed (e.g. a swarm that never came up): each set's plot still
+// shows its failed runs; the summary, with no mean to draw, is left out
+// instead of failing the whole report.
+TEST_F(ReportTest, EveryRunFailedPlotsTheSetsWithoutASummary) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  const auto pngs = write_plots({run("Sim 1", 0, kNaN, false), run("Sim 2", 0, kNaN, false)},
+                                path("plots"));
+  ASSERT_EQ(pngs.size(), 2u);
+  EXPECT_EQ(pngs[1], path("plots/sim_2.png"));
+  EXPECT_FALSE(fs::exists(path("plots/summary.png")));
+}
+
 TEST_F(ReportTest, PlotFailureReportsGnuplotsMessage) {
   if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed";
   // A directory where the png should go makes gnuplot fail to open its output.
