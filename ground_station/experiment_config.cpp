@@ -175,13 +175,15 @@ std::map<std::string, YAML::Node> parse_set_options(const std::vector<std::strin
 
 void override_every_set(ExperimentConfig& c, const std::map<std::string, YAML::Node>& overrides) {
   for (auto& set : c.sets) {
-    for (const auto& [key, value] : overrides) {
+    for (const auto& kv : overrides) {
       // The command line wins over the set's value for the key and for
       // anything under or above it (validate() rejects a key and its child).
+      // (kv, not a structured binding: clang 14, the fuzz build, cannot capture one.)
+      const std::string& key = kv.first;
       std::erase_if(set.overrides, [&](const auto& o) {
         return o.first == key || o.first.starts_with(key + ".") || key.starts_with(o.first + ".");
       });
-      set.overrides[key] = YAML::Clone(value);
+      set.overrides[key] = YAML::Clone(kv.second);
     }
   }
   c.validate();
