@@ -280,9 +280,15 @@ DdsCommander::DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds)
     : impl_(std::make_unique<Impl>(cfg, dds)) {}
 DdsCommander::~DdsCommander() = default;
 
-bool DdsCommander::wait_for_swarm(int count, double timeout_s) {
+bool DdsCommander::wait_for_swarm(int count, double timeout_s,
+                                  const std::function<bool()>& give_up) {
   auto& I = *impl_;
-  return I.wait(timeout_s, [&] { return I.server_hears_at_least(count) && I.all_matched(); });
+  bool gave_up = false;
+  const bool up = I.wait(timeout_s, [&] {
+    gave_up = give_up && give_up();
+    return gave_up || (I.server_hears_at_least(count) && I.all_matched());
+  });
+  return up && !gave_up;
 }
 
 bool DdsCommander::wait_for_online(int count, double timeout_s) {

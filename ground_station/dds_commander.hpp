@@ -1,8 +1,9 @@
 #pragma once
 // The ground station's link to the swarm over DDS: sends mission commands,
 // gathers every live agent's acknowledgement, follows status and the task.
-#include <memory>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -40,8 +41,9 @@ class DdsCommander final : public Commander {
   /// process and in the server's own status (count < 0: as many as the
   /// server's scenario has), and this process's writers and readers are
   /// matched: everything a mission needs before its first command. Returns
-  /// false on timeout.
-  bool wait_for_swarm(int count, double timeout_s);
+  /// false on timeout, or at once when give_up() says so (polled every
+  /// 100 ms: e.g. a process of the swarm has died).
+  bool wait_for_swarm(int count, double timeout_s, const std::function<bool()>& give_up = {});
   /// Waits until the server is heard and count agents are online in its view
   /// (count < 0: as many as the scenario has), without waiting for this
   /// process's own connections to each agent: for `wait-agents`, whose

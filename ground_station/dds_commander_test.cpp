@@ -88,5 +88,19 @@ TEST(DdsCommander, WaitsForTheServerToHearEveryAgentNotOnlyItself) {
   EXPECT_TRUE(gs.wait_for_swarm(6, 10.0));
 }
 
+// An experiment's run whose server died at start-up: the wait ends at once,
+// not after its timeout (a minute per run before).
+TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  DdsCommander gs(GroundStationConfig{}, cfg);  // no swarm at all
+  std::atomic<int> asked{0};
+  const double t0 = wall_seconds();
+  EXPECT_FALSE(gs.wait_for_swarm(6, 30.0, [&] { return ++asked >= 3; }));
+  EXPECT_LT(wall_seconds() - t0, 2.0);
+  EXPECT_GE(asked.load(), 3);
+  EXPECT_FALSE(gs.wait_for_swarm(6, 0.3, [] { return false; }));  // a plain timeout still is one
+}
+
 }  // namespace
 }  // namespace ddswarm::gs

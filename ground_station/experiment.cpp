@@ -23,9 +23,14 @@ namespace ddswarm::gs {
 namespace fs = std::filesystem;
 
 TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
-                     const std::function<void(const std::string&)>& progress) {
+                     const std::function<void(const std::string&)>& progress,
+                     const std::function<bool()>& give_up) {
   TaskOutcome fail;
-  if (!gs.wait_for_swarm(drones, 30.0)) {
+  if (!gs.wait_for_swarm(drones, 30.0, give_up)) {
+    if (give_up && give_up()) {
+      fail.reason = "a process of the run ended before the swarm was up";
+      return fail;
+    }
     auto st = gs.status();
     fail.reason = fmt::format("only {}/{} agents online ({} heard by the server) after 30 s", st.drones_online,
                               drones, std::max(st.drones_server_hears, 0));
@@ -244,16 +249,24 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       DdsCommander gs(opt.gs, dds);
       // The sim-time limit per run: the task fails after cfg.timeout_s of sim time.
       std::atomic<bool> finished{false};
+      // A process that ends during the run fails it (rec.ok below); one that
+      // ends before the swarm is up also ends the wait for it, which would
+      // otherwise last a minute.
+      std::atomic<bool> someone_died{false};
       std::thread watchdog([&] {
         while (!finished && !stop_requested()) {
-          for (const auto& e : procs.reap()) died += (died.empty() ? "" : "; ") + e.describe();
+          for (const auto& e : procs.reap()) {
+            died += (died.empty() ? "" : "; ") + e.describe();
+            someone_died = true;
+          }
           std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
       });
-      gs.wait_for_swarm(rec.drones, 30.0);  // fly_task says so if it failed
+      const auto give_up = [&] { return someone_died.load(); };
+      gs.wait_for_swarm(rec.drones, 30.0, give_up);  // fly_task says so if it failed
       const double flight_start = wall_seconds();
       times.startup_s = flight_start - run_start;
-      o = fly_task(gs, rec.drones, p.task, nullptr);
+      o = fly_task(gs, rec.drones, p.task, nullptr, give_up);
       times.flight_s = wall_seconds() - flight_start;
       finished = true;
       watchdog.join();

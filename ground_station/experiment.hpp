@@ -14,8 +14,11 @@ namespace ddswarm::gs {
 
 /// Waits for `drones` agents, takes off, waits until airborne, starts the
 /// task and waits for its result. Failures come back as an outcome with a reason.
+/// give_up (optional) ends the wait for the swarm at once, e.g. when a
+/// process of the run has died.
 TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
-                     const std::function<void(const std::string&)>& progress);
+                     const std::function<void(const std::string&)>& progress,
+                     const std::function<bool()>& give_up = {});
 
 struct ExperimentOptions {
   std::string out_dir = "results";  ///< CSV, table, plots, per-run scenarios and logs go here
