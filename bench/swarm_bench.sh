@@ -15,6 +15,8 @@
 #                      physics runs while agents answer; commands act one tick later) and
 #                      hosts (plain, the N drones' agents in --lockstep-hosts K agent-host
 #                      processes, default 2: the same laws, far fewer DDS round trips)
+#   --physics "1000 500 250"   lockstep physics rates (sim.physics_rate_hz), each flown with
+#                      every variant against the same floor (default: the scenario's, 1000)
 #   --rt-time S        real-time seconds measured per N (default 60)
 #   --streams best-effort|reliable   every part (the floor, lockstep, real time, agent hosts, Table 1):
 #                      how the server reads the commands and the agents the state (writers stay
@@ -60,6 +62,7 @@ HOSTS_SENS=10
 T1_JOBS=2
 LS_VARIANTS="plain pipelined hosts"
 LS_HOSTS_K=2
+LS_PHYSICS=""
 STREAMS=best-effort
 RT_GRACE=0.6
 while [ $# -gt 0 ]; do
@@ -85,6 +88,7 @@ while [ $# -gt 0 ]; do
     --table1-jobs) T1_JOBS="$2"; shift 2 ;;
     --quick) SIZES="4 8"; LS_TIME=3; RT_TIME=5; FLOOR_TIME=2; FLOOR_REPEATS=1; T1_RUNS=1; HOSTS_N=16; shift ;;
     --lockstep) LS_VARIANTS="$2"; shift 2 ;;
+    --physics) LS_PHYSICS="$2"; shift 2 ;;
     --streams|--rt-streams) STREAMS="$2"; shift 2 ;;
     --rt-grace) RT_GRACE="$2"; shift 2 ;;
     -h|--help) sed -n '2,/^set -u/{/^#/p}' "$0"; exit 0 ;;
@@ -252,28 +256,32 @@ note_cell() { echo "$1" | sed -n 's/.*why="\([^"]*\)".*/\1/p'; }
 if ! skip lockstep; then
   : >"$OUT/lockstep.txt"
   for n in $SIZES; do
-    for v in $LS_VARIANTS; do
-      case "$v" in
-        plain) RUN_EXTRA=("${STREAM_EXTRA[@]}"); RUN_TAG="" ;;
-        pipelined) RUN_EXTRA=("${STREAM_EXTRA[@]}" --set sim.lockstep_pipeline=true); RUN_TAG="-pipelined" ;;
-        hosts) RUN_EXTRA=("${STREAM_EXTRA[@]}" --agent-hosts "$LS_HOSTS_K"); RUN_TAG="-lockstep-hosts" ;;
-        *) echo "swarm_bench: unknown lockstep variant '$v' (plain, pipelined, hosts)" >&2; exit 2 ;;
-      esac
-      echo "swarm_bench: lockstep N=$n, $v (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
-      RUN_TOOL_ARGS=("${STREAM_TOOL_ARGS[@]}")
-      echo "variant=$v $(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
+    for hz in ${LS_PHYSICS:-$PHYS_HZ}; do
+      for v in $LS_VARIANTS; do
+        case "$v" in
+          plain) RUN_EXTRA=("${STREAM_EXTRA[@]}"); RUN_TAG="" ;;
+          pipelined) RUN_EXTRA=("${STREAM_EXTRA[@]}" --set sim.lockstep_pipeline=true); RUN_TAG="-pipelined" ;;
+          hosts) RUN_EXTRA=("${STREAM_EXTRA[@]}" --agent-hosts "$LS_HOSTS_K"); RUN_TAG="-lockstep-hosts" ;;
+          *) echo "swarm_bench: unknown lockstep variant '$v' (plain, pipelined, hosts)" >&2; exit 2 ;;
+        esac
+        # After SETS on the launcher's command line, so this rate wins.
+        [ -n "$LS_PHYSICS" ] && { RUN_EXTRA+=(--set "sim.physics_rate_hz=$hz"); RUN_TAG+="-${hz}hz"; }
+        echo "swarm_bench: lockstep N=$n, $v, physics $hz Hz (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
+        RUN_TOOL_ARGS=("${STREAM_TOOL_ARGS[@]}")
+        echo "variant=$v physics=$hz $(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
+      done
     done
   done
   RUN_EXTRA=(); RUN_TAG=""; RUN_TOOL_ARGS=()
   echo
-  echo "== lockstep: $STREAMS state and commands; ticks/s with physics ($PHYS_HZ Hz) and sensors (8 rays, $SENS_HZ Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
-  echo "| N | variant | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "== lockstep: $STREAMS state and commands; ticks/s with physics (Hz as given) and sensors (8 rays, $SENS_HZ Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
+  echo "| N | variant | physics (Hz) | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   while read -r l; do
     n=$(field n "$l"); t=$(field ticks_per_s "$l"); f=$(field floor "$l")
     ratio=$(echo "$t $f" | awk '{ if ($1+0 > 0 && $2+0 > 0) printf "%.2f", $1 / $2; else print "-" }')
     rtf=$(echo "$t" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')
-    printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "${t:--}" "$rtf" \
+    printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "$(field physics "$l")" "${t:--}" "$rtf" \
       "$(echo "$f" | awk '{ printf "%.0f", $1 }')" "$ratio" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
       "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field rss_agent_mb "$l")" "$(field pss_agent_mb "$l")" \
       "$(up_cell "$l")" "$(field contacts "$l")" "$(field load "$l")" \
@@ -343,11 +351,13 @@ fi
 if [ -n "$PLOT" ] && [ -f "$OUT/lockstep.txt" ]; then
   : >"$OUT/plot.dat"
   # One row per N: plain, floor, pipelined, hosts (? where a variant was not
-  # run, or its run failed: a swarm that never took off measures nothing).
+  # run, or its run failed: a swarm that never took off measures nothing),
+  # at the first physics rate flown.
+  plot_hz=$(echo ${LS_PHYSICS:-$PHYS_HZ} | cut -d' ' -f1)
   for n in $SIZES; do
     t="?"; p="?"; f="?"; h="?"
     while read -r l; do
-      [ "$(field n "$l")" = "$n" ] || continue
+      [ "$(field n "$l")" = "$n" ] && [ "$(field physics "$l")" = "$plot_hz" ] || continue
       f=$(field floor "$l")
       [ -n "$(note_cell "$l")" ] && continue
       case "$(field variant "$l")" in

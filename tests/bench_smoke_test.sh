@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Issue 8: the scale benches run and print their tables (bench/swarm_bench.sh
-# --quick at tiny N). No timed assertion: figures are printed, never judged.
+# --quick at tiny N, lockstep at two physics rates). No timed assertion:
+# figures are printed, never judged.
 source "$(dirname "$0")/lib.sh"
-start bench bash "$SRC/bench/swarm_bench.sh" --bin "$BIN" --quick --sizes 3 --out "$WORK/out"
+start bench bash "$SRC/bench/swarm_bench.sh" --bin "$BIN" --quick --sizes 3 --physics "1000 250" --out "$WORK/out"
 wait_pid "$PID_bench" 400; rc=$?
 out="$WORK/bench.log"
 [ $rc -eq 0 ] || fail "swarm_bench exit $rc"
@@ -12,7 +13,10 @@ done
 # Each table has a row for N = 3 with a figure in it, and Table 1 its split.
 grep -Eq '^\| 3 \| simple \| [0-9]+ \|' "$out" || fail "floor row for N=3 missing or empty"
 for v in plain pipelined hosts; do
-  grep -Eq "^\\| 3 \\| $v \\| [0-9.]+ \\| [0-9.]+ \\|" "$out" || fail "lockstep $v row for N=3 missing or empty"
+  for hz in 1000 250; do
+    grep -Eq "^\\| 3 \\| $v \\| $hz \\| [0-9.]+ \\| [0-9.]+ \\|" "$out" ||
+      fail "lockstep $v row at $hz Hz physics for N=3 missing or empty"
+  done
 done
 grep -Eq '^\| 3 \| [0-9.]+ \| [0-9]+ / [0-9]+ / [0-9]+ \|' "$out" || fail "real-time row for N=3 missing or empty"
 grep -Eq '^\| task flight \| [0-9.]+ \|' "$out" || fail "Table 1 split missing"
