@@ -72,6 +72,13 @@ std::string md_text(const std::string& s) {
 
 double t_critical_5pct(double df) {
   if (!(df > 0)) return kNaN;
+  // Below 3 degrees of freedom (two runs a side) the expansion is far too
+  // low: the table's values, linear in 1/df between them.
+  if (df < 3) {
+    const double inv = 1 / std::max(df, 1.0);
+    return inv >= 0.5 ? 4.303 + (inv - 0.5) / 0.5 * (12.706 - 4.303)
+                      : 3.182 + (inv - 1.0 / 3) / (0.5 - 1.0 / 3) * (4.303 - 3.182);
+  }
   // Cornish–Fisher expansion of Student's t quantile around the normal one.
   const double z = 1.959963984540054, z2 = z * z;
   const double g1 = (z2 * z + z) / 4;

@@ -26,7 +26,8 @@ struct SetComparison {
 };
 
 /// The two-sided 5 % critical value of Student's t with df degrees of freedom
-/// (Cornish–Fisher expansion: within 0.3 % of the table from df = 3 up).
+/// (Cornish–Fisher expansion: within 0.3 % of the table from df = 3 up;
+/// below 3, the table's values at 1, 2 and 3, linear in 1/df between them).
 double t_critical_5pct(double df);
 
 /// Every set of base, in its order, then the sets only other has.

@@ -31,6 +31,9 @@ std::vector<RunRecord> set_of(const std::string& set, const std::vector<double>&
 
 TEST(Compare, CriticalValuesMatchStudentsTable) {
   // Two-sided 5 %: the textbook table.
+  EXPECT_NEAR(t_critical_5pct(1), 12.706, 0.001);  // two runs a side can give df near 1
+  EXPECT_NEAR(t_critical_5pct(2), 4.303, 0.001);
+  EXPECT_NEAR(t_critical_5pct(2.999), 3.182, 0.01);
   EXPECT_NEAR(t_critical_5pct(3), 3.182, 0.01);
   EXPECT_NEAR(t_critical_5pct(10), 2.228, 0.002);
   EXPECT_NEAR(t_critical_5pct(28), 2.048, 0.001);
