@@ -1,10 +1,8 @@
 #include "ground_station/launcher.hpp"
 
-#include "common/dds_config.hpp"
-
 #include <arpa/inet.h>
-#include <fmt/format.h>
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -22,6 +20,9 @@
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
+
+#include "common/dds_config.hpp"
 
 namespace ddswarm::gs {
 
@@ -61,7 +62,14 @@ std::string Launcher::self_dir() {
   return ec ? std::string(".") : p.parent_path().string();
 }
 
-ChildExit run_to_end(const ChildSpec& spec, std::string& output) {
+namespace {
+
+/// Forks and execs spec with its stdout and stderr into a new pipe, the child
+/// dying with this process (SIGTERM). new_group: the child leads its own
+/// process group, so Ctrl-C reaches only the launcher, which stops children in
+/// order. Returns the pid and the pipe's read end; throws std::runtime_error
+/// naming the program when it cannot start.
+std::pair<pid_t, int> spawn_piped(const ChildSpec& spec, bool new_group) {
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
   if (access(spec.argv.at(0).c_str(), X_OK) != 0) {
@@ -69,6 +77,7 @@ ChildExit run_to_end(const ChildSpec& spec, std::string& output) {
     close(fds[1]);
     throw std::runtime_error("cannot run " + spec.argv[0] + ": " + std::strerror(errno));
   }
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) {
     close(fds[0]);
@@ -77,6 +86,8 @@ ChildExit run_to_end(const ChildSpec& spec, std::string& output) {
   }
   if (pid == 0) {
     prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);  // the parent died before prctl
+    if (new_group) setpgid(0, 0);
     dup2(fds[1], STDOUT_FILENO);
     dup2(fds[1], STDERR_FILENO);
     std::vector<char*> argv;
@@ -87,17 +98,24 @@ ChildExit run_to_end(const ChildSpec& spec, std::string& output) {
     _exit(127);
   }
   close(fds[1]);
+  return {pid, fds[0]};
+}
+
+}  // namespace
+
+ChildExit run_to_end(const ChildSpec& spec, std::string& output) {
+  const auto [pid, out_fd] = spawn_piped(spec, false);
   output.clear();
   char buf[4096];
   for (;;) {
-    const ssize_t n = read(fds[0], buf, sizeof buf);
+    const ssize_t n = read(out_fd, buf, sizeof buf);
     if (n > 0) {
       output.append(buf, static_cast<std::size_t>(n));
     } else if (n == 0 || errno != EINTR) {
       break;
     }
   }
-  close(fds[0]);
+  close(out_fd);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
@@ -110,35 +128,11 @@ ChildExit run_to_end(const ChildSpec& spec, std::string& output) {
 }
 
 pid_t Launcher::start(const ChildSpec& spec) {
-  int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
-  if (access(spec.argv.at(0).c_str(), X_OK) != 0) {
-    close(fds[0]);
-    close(fds[1]);
-    throw std::runtime_error("cannot run " + spec.argv[0] + ": " + std::strerror(errno));
-  }
-  const pid_t parent = getpid();
-  pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed for " + spec.name);
-  if (pid == 0) {
-    // Child: die with the launcher, write into the pipe, run the program.
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(127);
-    setpgid(0, 0);  // Ctrl-C reaches the launcher, which stops children in order
-    dup2(fds[1], STDOUT_FILENO);
-    dup2(fds[1], STDERR_FILENO);
-    std::vector<char*> argv;
-    for (const auto& a : spec.argv) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(argv[0], argv.data());
-    std::fprintf(stderr, "cannot exec %s: %s\n", argv[0], std::strerror(errno));
-    _exit(127);
-  }
-  close(fds[1]);
+  const auto [pid, out_fd] = spawn_piped(spec, true);
   auto c = std::make_unique<Child>();
   c->name = spec.name;
   c->pid = pid;
-  c->out_fd = fds[0];
+  c->out_fd = out_fd;
   if (!log_dir_.empty()) {
     std::string file = spec.name;
     for (auto& ch : file)
