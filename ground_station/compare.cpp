@@ -15,25 +15,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-struct Moments {
-  int n = 0;
-  double mean = kNaN, var = kNaN;
-};
-
-Moments moments(const std::vector<double>& x) {
-  Moments m;
-  m.n = static_cast<int>(x.size());
-  if (m.n == 0) return m;
-  double sum = 0;
-  for (double v : x) sum += v;
-  m.mean = sum / m.n;
-  if (m.n < 2) return m;
-  double ss = 0;
-  for (double v : x) ss += (v - m.mean) * (v - m.mean);
-  m.var = ss / (m.n - 1);
-  return m;
-}
-
 /// Successful runs' task times by seed, for one set.
 std::map<std::uint64_t, double> times_by_seed(const std::vector<RunRecord>& records,
                                               const std::string& set) {
@@ -43,15 +24,9 @@ std::map<std::uint64_t, double> times_by_seed(const std::vector<RunRecord>& reco
   return out;
 }
 
-std::vector<double> values(const std::map<std::uint64_t, double>& m) {
-  std::vector<double> v;
-  for (const auto& [seed, t] : m) v.push_back(t);
-  return v;
-}
-
 std::string mean_sd(const SetSummary& s) {
   if (s.runs == 0) return "absent";
-  const int ok = s.runs - s.failures;
+  const int ok = s.successes;
   if (!std::isfinite(s.mean_time_s)) return fmt::format("n/a ({}/{})", ok, s.runs);
   if (!std::isfinite(s.stddev_time_s))
     return fmt::format("{:.2f} s ({}/{})", s.mean_time_s, ok, s.runs);
@@ -105,16 +80,21 @@ std::vector<SetComparison> compare_sets(const std::vector<RunRecord>& base,
       if (s.name == name) c.base = s;
     for (const auto& s : so)
       if (s.name == name) c.other = s;
-    const auto tb = times_by_seed(base, name), to = times_by_seed(other, name);
-    const Moments a = moments(values(tb)), b = moments(values(to));
-    c.mean_diff_s = b.mean - a.mean;  // NaN when either side has none
+    // The statistics summarize() already took of each side's successful runs.
+    const auto mean = [](const SetSummary& x) { return x.successes > 0 ? x.mean_time_s : kNaN; };
+    const double na = c.base.successes, nb = c.other.successes;
+    c.mean_diff_s = mean(c.other) - mean(c.base);  // NaN when either side has none
     c.welch_t = c.welch_df = kNaN;
-    const double va = a.var / a.n, vb = b.var / b.n;
-    if (a.n >= 2 && b.n >= 2 && va + vb > 0) {
-      c.welch_t = c.mean_diff_s / std::sqrt(va + vb);
-      c.welch_df = (va + vb) * (va + vb) / (va * va / (a.n - 1) + vb * vb / (b.n - 1));
-      c.significant = std::abs(c.welch_t) > t_critical_5pct(c.welch_df);
+    if (na >= 2 && nb >= 2) {
+      const double va = c.base.stddev_time_s * c.base.stddev_time_s / na;
+      const double vb = c.other.stddev_time_s * c.other.stddev_time_s / nb;
+      if (va + vb > 0) {
+        c.welch_t = c.mean_diff_s / std::sqrt(va + vb);
+        c.welch_df = (va + vb) * (va + vb) / (va * va / (na - 1) + vb * vb / (nb - 1));
+        c.significant = std::abs(c.welch_t) > t_critical_5pct(c.welch_df);
+      }
     }
+    const auto tb = times_by_seed(base, name), to = times_by_seed(other, name);
     double sum = 0, most = 0;
     for (const auto& [seed, t] : tb) {
       auto it = to.find(seed);

@@ -103,10 +103,6 @@ struct RunTimes {
   double teardown_s = 0;  ///< stopping every process
 };
 
-}  // namespace
-
-namespace {
-
 /// A bad key or value in a set (or a --set) fails each of its runs at
 /// start-up, after a minute's wait for a swarm that never comes: the ground
 /// station, the server and an agent read each set's first run file as they

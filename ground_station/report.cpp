@@ -315,7 +315,8 @@ void run_gnuplot(const std::string& dir, const std::string& script, const std::s
   }
 }
 
-std::string plot_script(const std::string& stem, const SetSummary& s, int max_run) {
+/// The gnuplot commands of one set's plot (render_gnuplot() adds the terminals).
+std::string plot_body(const std::string& stem, const SetSummary& s, int max_run) {
   std::ostringstream title;
   title << s.name << ": time to complete (" << s.drones << " drones, D_int "
         << shortest(s.d_int_m, " m") << ", " << shortest(s.speed_mps, " m/s") << ", "
@@ -347,17 +348,7 @@ std::string plot_script(const std::string& stem, const SetSummary& s, int max_ru
     gp << "set yrange [0:1]\nset label 1 'no successful runs' at graph 0.5, graph 0.5 center\n"
        << "plot 1/0 notitle\n";
   }
-  std::string body = gp.str();
-  std::ostringstream out;
-  out << "if (strstrt(GPVAL_TERMINALS, ' pngcairo ') > 0) {\n"
-      << "  set terminal pngcairo size 800,500 noenhanced font 'sans,10'\n"
-      << "} else {\n"
-      << "  set terminal png size 800,500 noenhanced\n"
-      << "}\n"
-      << "set output " << gnuplot_string(stem + ".png") << "\n"
-      << body << "set terminal svg size 800,500 noenhanced\n"
-      << "set output " << gnuplot_string(stem + ".svg") << "\nreplot\nunset output\n";
-  return out.str();
+  return gp.str();
 }
 
 }  // namespace
@@ -493,6 +484,7 @@ std::vector<SetSummary> summarize(const std::vector<RunRecord>& records) {
       s.min_inter_drone_m = std::fmin(s.min_inter_drone_m, r->min_inter_drone_m);
       s.min_clearance_m = std::fmin(s.min_clearance_m, r->min_clearance_m);
     }
+    s.successes = static_cast<int>(times.size());
     const double n = static_cast<double>(runs.size());
     s.mean_collisions = collisions / n;
     s.mean_collisions_obstacle = obstacle / n;
@@ -599,19 +591,8 @@ std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
           << ' ' << r->collisions() << ' ' << (r->ok ? 1 : 0) << '\n';
       max_run = std::max(max_run, r->run_index + 1);
     }
-    const std::string base = dir + "/" + stem;
-    write_text(base + ".dat", dat.str());
-    write_text(base + ".gp", plot_script(stem, summaries[i], max_run));
-    std::error_code rm;
-    fs::remove(base + ".png", rm);
-    fs::remove(base + ".svg", rm);
-    run_gnuplot(dir, base + ".gp", base + ".log");
-    for (const char* ext : {".png", ".svg"}) {
-      if (fs::file_size(base + ext, rm) == 0 || rm)
-        throw std::runtime_error(base + ext + ": gnuplot wrote no plot (see " + base + ".log)");
-    }
-    fs::remove(base + ".log", rm);
-    pngs.push_back(base + ".png");
+    write_text(dir + "/" + stem + ".dat", dat.str());
+    pngs.push_back(render_gnuplot(dir, stem, plot_body(stem, summaries[i], max_run), 800, 500));
   }
   // The summary needs a mean to draw: with every run failed, gnuplot finds no point at all.
   const bool any_mean = std::any_of(summaries.begin(), summaries.end(),
@@ -670,10 +651,14 @@ std::string render_gnuplot(const std::string& dir, const std::string& stem, cons
          << plot << "set terminal svg size " << size << " noenhanced\n"
          << "set output " << gnuplot_string(stem + ".svg") << "\nreplot\nunset output\n";
   write_text(base + ".gp", script.str());
-  run_gnuplot(dir, base + ".gp", base + ".log");
   std::error_code rm;
-  if (fs::file_size(base + ".png", rm) == 0 || rm)
-    throw std::runtime_error(base + ".png: gnuplot wrote no plot (see " + base + ".log)");
+  fs::remove(base + ".png", rm);  // an old plot must not pass for this one
+  fs::remove(base + ".svg", rm);
+  run_gnuplot(dir, base + ".gp", base + ".log");
+  for (const char* ext : {".png", ".svg"}) {
+    if (fs::file_size(base + ext, rm) == 0 || rm)
+      throw std::runtime_error(base + ext + ": gnuplot wrote no plot (see " + base + ".log)");
+  }
   fs::remove(base + ".log", rm);
   return base + ".png";
 }

@@ -58,6 +58,7 @@ struct SetSummary {
   std::string mode;             ///< from the set's first run
   int runs = 0;                 ///< runs recorded
   int failures = 0;             ///< runs with ok == false
+  int successes = 0;  ///< runs with ok and a finite task time (what the time statistics use)
   double mean_time_s = 0;       ///< s, mean task time of successful runs (NaN: none)
   double stddev_time_s = 0;     ///< s, sample standard deviation (n-1) of the same (NaN: < 2)
   double min_time_s = 0;        ///< s, over successful runs (NaN: none)
@@ -102,7 +103,7 @@ std::string gnuplot_string(const std::string& s);
 /// Writes <dir>/<stem>.gp: `plot` (gnuplot commands that draw one figure)
 /// rendered to <stem>.png (pngcairo, or png without cairo) and <stem>.svg at
 /// width x height; runs gnuplot in dir. Returns the png path; throws
-/// std::runtime_error when gnuplot is missing, fails or writes no png.
+/// std::runtime_error when gnuplot is missing, fails or writes no png or svg.
 std::string render_gnuplot(const std::string& dir, const std::string& stem, const std::string& plot,
                            int width, int height);
 
