@@ -523,7 +523,21 @@ struct AgentApp::Impl {
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
     else
       spdlog::info("{}: flying drones {}..{} (pid {})", label, brains.front()->id, brains.back()->id, getpid());
+    double last_turn = wall_seconds();
     while (!stop_requested() && wall_seconds() < end) {
+      // This loop turns at least every 250 ms. A longer gap than the lease
+      // this participant announces (SIGSTOP, a debugger, a starved machine)
+      // let its peers drop it while it still holds them: Fast DDS 2.9 does
+      // not always recover from such a one-sided loss (an agent stayed deaf
+      // to the server after SIGCONT, docs/faults.md). A new participant is
+      // discovered afresh by everyone.
+      const double gap = wall_seconds() - std::exchange(last_turn, wall_seconds());
+      if (gap > cfg.dds.lease_duration_s) {
+        spdlog::warn("{}: this process was stopped or starved for {:.1f} s, longer than its DDS lease "
+                     "({:.1f} s, dds.lease_duration_s); leaving DDS and joining again as a new participant",
+                     label, gap, cfg.dds.lease_duration_s);
+        return AgentApp::End::kOutlivedLease;
+      }
       if (take_rejoin_request()) {
         spdlog::warn("{}: asked to join again (SIGUSR1: the discovery server dropped this participant's "
                      "endpoints); leaving DDS and joining again as a new participant",

@@ -42,11 +42,13 @@ class AgentApp {
   /// Joins DDS and checks that no other agent flies this drone (throws DuplicateAgent).
   explicit AgentApp(AgentAppConfig cfg);
   ~AgentApp();
-  enum class End { kStopped, kNoScene, kRejoinRequested };
+  enum class End { kStopped, kNoScene, kRejoinRequested, kOutlivedLease };
   /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
   /// kStopped. kNoScene when no scene came within agent.rejoin_after_s of
-  /// joining, kRejoinRequested on take_rejoin_request() (SIGUSR1): the caller
-  /// should destroy this app and join again.
+  /// joining, kRejoinRequested on take_rejoin_request() (SIGUSR1),
+  /// kOutlivedLease when this process was stopped or starved for longer than
+  /// its DDS lease (dds.lease_duration_s), so its peers may have dropped it:
+  /// the caller should destroy this app and join again.
   End run(double duration_s);
 
  private:

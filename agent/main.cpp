@@ -77,7 +77,8 @@ int main(int argc, char** argv) {
     ddswarm::install_rejoin_signal();
     try {
       using ddswarm::agent::AgentApp;
-      // A new participant each time no scene came (agent.rejoin_after_s) or SIGUSR1 asked for one.
+      // A new participant each time no scene came (agent.rejoin_after_s), SIGUSR1 asked for one,
+      // or this process outlived its DDS lease (stopped or starved).
       ddswarm::keep_joining(duration_s, [&](double left) {
         AgentApp agent(cfg);
         return agent.run(left) != AgentApp::End::kStopped;

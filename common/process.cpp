@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <exception>
 #include <mutex>
+#include <pthread.h>
 #include <random>
+#include <thread>
 #include <unistd.h>
 
 #include "common/config_error.hpp"
@@ -22,6 +24,32 @@ std::atomic<bool> g_rejoin{false};
 
 extern "C" void on_signal(int) { g_stop.store(true); }
 extern "C" void on_rejoin_signal(int) { g_rejoin.store(true); }
+
+sigset_t signals_of(std::initializer_list<int> sigs) {
+  sigset_t set;
+  sigemptyset(&set);
+  for (int s : sigs) sigaddset(&set, s);
+  return set;
+}
+
+// Takes the signals that every other thread blocks. Fast DDS's threads wait
+// on interprocess semaphores, and boost::interprocess throws on EINTR: a
+// SIGTERM handled on one of them ends the process in std::terminate. That
+// happened to an agent sent SIGTERM while stopped (SIGSTOP) and then
+// SIGCONT: a stopped process's signal goes to whichever thread runs first.
+void take_signals() {
+  const sigset_t set = signals_of({SIGINT, SIGTERM, SIGUSR1});
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  for (;;) {
+    int sig = 0;
+    if (sigwait(&set, &sig) != 0) continue;
+    if (sig == SIGUSR1) {
+      g_rejoin.store(true);
+    } else {
+      request_stop();
+    }
+  }
+}
 }  // namespace
 
 void install_rejoin_signal() {
@@ -29,6 +57,14 @@ void install_rejoin_signal() {
   sa.sa_handler = on_rejoin_signal;
   sigemptyset(&sa.sa_mask);
   sigaction(SIGUSR1, &sa, nullptr);
+  const sigset_t set = signals_of({SIGUSR1});
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+}
+
+void unblock_signals_for_exec() {
+  sigset_t none;
+  sigemptyset(&none);
+  pthread_sigmask(SIG_SETMASK, &none, nullptr);
 }
 
 bool take_rejoin_request() { return g_rejoin.exchange(false); }
@@ -43,12 +79,20 @@ void keep_joining(double duration_s, const std::function<bool(double left_s)>& j
 }
 
 void install_stop_signals() {
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  std::signal(SIGPIPE, SIG_IGN);
+  static std::once_flag once;
+  std::call_once(once, [] {
+    // The handlers serve a thread started before this call, if any.
+    struct sigaction sa {};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+    std::signal(SIGPIPE, SIG_IGN);
+    // Every thread started from here on inherits the mask: only take_signals gets them.
+    const sigset_t set = signals_of({SIGINT, SIGTERM});
+    pthread_sigmask(SIG_BLOCK, &set, nullptr);
+    std::thread(take_signals).detach();
+  });
 }
 
 bool stop_requested() { return g_stop.load(); }
@@ -59,7 +103,8 @@ void request_stop() {
 }
 
 bool wait_for_stop(std::chrono::duration<double> d) {
-  // Signal handlers cannot notify a condition variable; poll in short slices.
+  // A signal handler cannot notify a condition variable (take_signals does);
+  // poll in short slices.
   auto end = std::chrono::steady_clock::now() +
              std::chrono::duration_cast<std::chrono::steady_clock::duration>(d);
   std::unique_lock<std::mutex> lock(g_mu);

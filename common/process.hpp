@@ -7,7 +7,9 @@
 
 namespace ddswarm {
 
-/// Installs SIGINT/SIGTERM handlers that request a stop (idempotent).
+/// SIGINT/SIGTERM request a stop (idempotent). Call it first in main, before
+/// any thread starts: it blocks them in the calling thread, so in every thread
+/// started afterwards (Fast DDS's), and one thread of its own takes them.
 void install_stop_signals();
 /// True once a stop was requested (signal or request_stop()).
 bool stop_requested();
@@ -17,8 +19,12 @@ bool wait_for_stop(std::chrono::duration<double> d);
 
 /// SIGUSR1 asks the process to leave DDS and join again as a new participant
 /// (ddswarm-launch sends it to an agent whose endpoints its discovery server
-/// dropped). Installs the handler (idempotent).
+/// dropped). Installs the handler and blocks SIGUSR1 like install_stop_signals
+/// (idempotent; call it before any thread starts).
 void install_rejoin_signal();
+/// In a forked child, before exec: the signals install_stop_signals blocked
+/// reach the new program again.
+void unblock_signals_for_exec();
 /// True once per SIGUSR1 received since the last call.
 bool take_rejoin_request();
 

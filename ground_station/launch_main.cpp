@@ -49,6 +49,7 @@ int run_foreground(const std::vector<std::string>& argv, Launcher& procs, bool s
                    bool& died) {
   pid_t pid = fork();
   if (pid == 0) {
+    unblock_signals_for_exec();
     std::vector<char*> a;
     for (const auto& s : argv) a.push_back(const_cast<char*>(s.c_str()));
     a.push_back(nullptr);

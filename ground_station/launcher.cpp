@@ -23,6 +23,7 @@
 #include <utility>
 
 #include "common/dds_config.hpp"
+#include "common/process.hpp"
 
 namespace ddswarm::gs {
 
@@ -88,6 +89,7 @@ std::pair<pid_t, int> spawn_piped(const ChildSpec& spec, bool new_group) {
     prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (getppid() != parent) _exit(127);  // the parent died before prctl
     if (new_group) setpgid(0, 0);
+    unblock_signals_for_exec();
     dup2(fds[1], STDOUT_FILENO);
     dup2(fds[1], STDERR_FILENO);
     std::vector<char*> argv;

@@ -1,6 +1,7 @@
 #include "ground_station/report.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -298,9 +299,17 @@ void run_gnuplot(const std::string& dir, const std::string& script, const std::s
   std::vector<char*> argv = {const_cast<char*>("gnuplot"), const_cast<char*>("-e"),
                              const_cast<char*>(cd.c_str()), const_cast<char*>(script.c_str()),
                              nullptr};
+  // Not the stop signals this process blocks for its own threads (install_stop_signals).
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attr, &none);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
   pid_t pid = 0;
-  const int err = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv.data(), environ);
+  const int err = posix_spawnp(&pid, "gnuplot", &actions, &attr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attr);
   if (err == ENOENT)
     throw std::runtime_error("gnuplot not found on PATH; install it (apt-get install gnuplot-nox)");
   if (err != 0) throw io_error("gnuplot", "cannot start", err);
