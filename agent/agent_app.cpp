@@ -531,11 +531,13 @@ struct AgentApp::Impl {
       // not always recover from such a one-sided loss (an agent stayed deaf
       // to the server after SIGCONT, docs/faults.md). A new participant is
       // discovered afresh by everyone.
-      const double gap = wall_seconds() - std::exchange(last_turn, wall_seconds());
+      const double now = wall_seconds();
+      const double gap = now - std::exchange(last_turn, now);
       if (gap > cfg.dds.lease_duration_s) {
-        spdlog::warn("{}: this process was stopped or starved for {:.1f} s, longer than its DDS lease "
-                     "({:.1f} s, dds.lease_duration_s); leaving DDS and joining again as a new participant",
-                     label, gap, cfg.dds.lease_duration_s);
+        spdlog::warn(
+            "{}: this process was stopped or starved for {:.1f} s, longer than its DDS lease "
+            "({:.1f} s, dds.lease_duration_s); leaving DDS and joining again as a new participant",
+            label, gap, cfg.dds.lease_duration_s);
         return AgentApp::End::kOutlivedLease;
       }
       if (take_rejoin_request()) {

@@ -1,16 +1,17 @@
 #include "common/process.hpp"
 
+#include <pthread.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
-#include <algorithm>
 #include <exception>
 #include <mutex>
-#include <pthread.h>
 #include <random>
 #include <thread>
-#include <unistd.h>
 
 #include "common/config_error.hpp"
 
