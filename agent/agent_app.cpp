@@ -102,6 +102,10 @@ struct DroneBrain {
   // published it twice, a sample was lost) gets the same answer again, not
   // a second run of the mission machine and the law.
   std::optional<msg::VelocityCommand> last_answer;
+  // Wall time of the first swarm state, since this brain began answering,
+  // whose row for this drone says the server hears no live agent for it
+  // (no DRONE_AGENT_LIVE); -1 while the server hears it.
+  double unheard_since = -1;
 
   explicit DroneBrain(int drone_id) : id(drone_id) {}
 
@@ -371,6 +375,12 @@ struct AgentApp::Impl {
       ++b.rejected;
       return;
     }
+    // Answering, yet marked agent-less: the server does not hear this agent.
+    if (b.sent > 0 && !(me.flags() & msg::DRONE_AGENT_LIVE)) {
+      if (b.unheard_since < 0) b.unheard_since = wall_seconds();
+    } else {
+      b.unheard_since = -1;
+    }
     if (b.last_answer && b.last_answer->tick() == s.tick()) {
       w_cmd.write(*b.last_answer);
       return;
@@ -553,8 +563,25 @@ struct AgentApp::Impl {
         double silent = wall_seconds() - last_sample_wall;
         if (have_tick && !server_lost && silent > cfg.agent.server_timeout_s) {
           server_lost = true;
+          for (auto& b : brains) b->unheard_since = -1;  // counted again once it speaks
           spdlog::warn("{}: no server samples for {:.1f} s; holding commands until it returns",
                        label, silent);
+        }
+        // Hearing, but not heard: the server's samples say for a while that
+        // it has no live agent for a drone this process answers for. Its
+        // reader lost this participant one-sidedly (the server was stopped
+        // longer than this agent's lease, or discovery dropped this
+        // participant's endpoints): a new participant is discovered afresh.
+        for (const auto& b : brains) {
+          if (server_lost || b->unheard_since < 0) continue;
+          const double unheard = wall_seconds() - b->unheard_since;
+          if (unheard > 2 * cfg.dds.lease_duration_s) {
+            spdlog::warn("{}: the server's samples have marked drone {} agent-less for {:.1f} s while "
+                         "this agent answered them: the server does not hear this agent; leaving DDS "
+                         "and joining again as a new participant",
+                         label, b->id, unheard);
+            return AgentApp::End::kUnheard;
+          }
         }
         // Fast DDS 2.9 sometimes never matches one of 128 participants that
         // start at once (docs/performance.md); a new participant is

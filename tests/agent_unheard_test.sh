@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# An agent that hears the server but is not heard by it (here: its command
+# and heartbeat writers offer an ownership the server's readers do not
+# accept; in the field, a one-sided loss of its participant) must not fly on
+# silently. The server's samples mark its drone agent-less; after twice its
+# DDS lease the agent says so and joins again as a new participant.
+source "$(dirname "$0")/lib.sh"
+scenario="$SRC/config/thesis_course.yaml"
+# The shipped profiles, with EXCLUSIVE ownership on the agent's command and
+# heartbeat writers only (the server's readers are SHARED: no match).
+/usr/bin/python3 - "$SRC/config/dds_profiles.xml" "$WORK/deaf_profiles.xml" <<'PY'
+import re, sys
+xml = open(sys.argv[1]).read()
+for name in ("command", "heartbeat"):
+    pat = r'(<data_writer profile_name="%s">.*?<qos>)' % name
+    xml, n = re.subn(pat, r'\1<ownership><kind>EXCLUSIVE</kind></ownership>', xml, count=1, flags=re.S)
+    assert n == 1, name
+open(sys.argv[2], "w").write(xml)
+PY
+start sim "$BIN/ddswarm-sim" --scenario "$scenario" --drones 2 --mode realtime --domain "$DOMAIN"
+start agent0 "$BIN/ddswarm-agent" --id 0 --drones 2 --config "$scenario" --domain "$DOMAIN" \
+  --dds-profiles "$WORK/deaf_profiles.xml"
+start agent1 "$BIN/ddswarm-agent" --id 1 --drones 2 --config "$scenario" --domain "$DOMAIN"
+for _ in $(seq 200); do grep -q "does not hear this agent" "$WORK/agent0.log" && break; sleep 0.1; done
+cat "$WORK/agent0.log"
+grep -q "marked drone 0 agent-less .* the server does not hear this agent" "$WORK/agent0.log" ||
+  fail "agent 0 flew on unheard without saying so"
+grep -q "agent .* flying" "$WORK/agent0.log" || fail "agent 0 never flew"
+grep -q "drone 0: agent .* online" "$WORK/sim.log" && fail "the server heard agent 0 after all: the test's premise is broken"
+grep -q "drone 1: agent .* online" "$WORK/sim.log" || fail "the server did not hear the normal agent 1"
+grep -q "does not hear this agent" "$WORK/agent1.log" && fail "agent 1, heard, gave up its participant"
+echo PASS
