@@ -22,6 +22,26 @@ void strip_line_ending(std::string& s) {
   while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
 }
 
+// One byte of standard input, waiting with poll() so that stop() (a Ctrl-C,
+// taken on the signal thread: common/process.hpp) ends the wait within
+// 200 ms. Returns 1 (a byte), 0 (end of input or stop) or -1 (error).
+int read_stdin_byte(const std::function<bool()>& stop, char& byte) {
+  for (;;) {
+    if (stop && stop()) return 0;
+    pollfd p{STDIN_FILENO, POLLIN, 0};
+    const int ready = ::poll(&p, 1, 200);
+    if (ready < 0 && errno != EINTR) return -1;
+    if (ready <= 0) continue;
+    const ssize_t n = ::read(STDIN_FILENO, &byte, 1);
+    if (n == 0) return 0;
+    if (n < 0) {
+      if (errno == EINTR || errno == EAGAIN) continue;
+      return -1;
+    }
+    return 1;
+  }
+}
+
 }  // namespace
 
 // Owns the libedit state; el_end/history_end run in the destructor.
@@ -48,18 +68,9 @@ struct LineReader::Editline {
     Editline* e = self(el);
     std::mbstate_t state{};
     for (;;) {
-      if (e->stop && e->stop()) return 0;
-      pollfd p{STDIN_FILENO, POLLIN, 0};
-      const int ready = ::poll(&p, 1, 200);
-      if (ready < 0 && errno != EINTR) return -1;
-      if (ready <= 0) continue;
       char byte = 0;
-      const ssize_t n = ::read(STDIN_FILENO, &byte, 1);
-      if (n == 0) return 0;
-      if (n < 0) {
-        if (errno == EINTR || errno == EAGAIN) continue;
-        return -1;
-      }
+      const int got = read_stdin_byte(e->stop, byte);
+      if (got <= 0) return got;
       wchar_t wc = 0;
       const std::size_t used = std::mbrtowc(&wc, &byte, 1, &state);
       if (used == static_cast<std::size_t>(-2)) continue;  // more bytes of this character
@@ -128,6 +139,16 @@ LineReader::~LineReader() = default;
 
 void LineReader::set_interrupt(std::function<bool()> stop) { stop_ = std::move(stop); }
 
+bool LineReader::read_stdin_line(std::string& s) {
+  // Byte by byte from the descriptor, not through std::cin's buffer: the
+  // wait must see a stop, and no line may sit in a buffer poll() cannot see.
+  s.clear();
+  char byte = 0;
+  int got = 0;
+  while ((got = read_stdin_byte(stop_, byte)) == 1 && byte != '\n') s.push_back(byte);
+  return got == 1 || (got == 0 && !s.empty() && !(stop_ && stop_()));
+}
+
 bool LineReader::stop_now() {
   interrupted_ = stop_ && stop_();
   return interrupted_;
@@ -143,7 +164,7 @@ std::optional<std::string> LineReader::read(const std::string& prompt) {
   } else {
     out_ << prompt << std::flush;
     std::string s;
-    if (std::getline(in_, s)) {
+    if (&in_ == &std::cin ? read_stdin_line(s) : static_cast<bool>(std::getline(in_, s))) {
       strip_line_ending(s);
       out_ << s << '\n';
       line = std::move(s);

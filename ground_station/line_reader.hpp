@@ -49,6 +49,8 @@ class LineReader {
  private:
   struct Editline;
   bool stop_now();
+  /// A line of standard input without the newline; false at its end or on a stop.
+  bool read_stdin_line(std::string& s);
 
   std::istream& in_;
   std::ostream& out_;

@@ -4,6 +4,7 @@
 # Fast DDS's threads, it interrupted an interprocess wait and the process
 # died in std::terminate ("Interrupted system call"), 4 times in 30 for a
 # lone agent. Every process must stop cleanly instead: exit 0, nothing thrown.
+# The signals are now taken on one thread of each process (common/process.hpp).
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/config/thesis_course.yaml"
 start sim "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
@@ -20,6 +21,20 @@ stop_while_stopped() {  # NAME: SIGSTOP, SIGTERM, SIGCONT; it must exit 0
   [ $rc -eq 0 ] || fail "$name exited $rc after SIGTERM while stopped"
   if grep -q "terminate called" "$WORK/$name.log"; then fail "$name: $(grep -A1 'terminate called' "$WORK/$name.log")"; fi
 }
+
+# The ground-station console reading a pipe: its main thread waits for a
+# line while the signal thread takes Ctrl-C; the wait must see the stop.
+mkfifo "$WORK/menu.in"
+start menu_input bash -c "exec sleep 60 > '$WORK/menu.in'"
+start menu bash -c "exec '$BIN/ddswarm-gs' --config '$scenario' --domain $DOMAIN menu < '$WORK/menu.in'"
+prompted() { [ "$(tail -c 2 "$WORK/menu.log")" = "> " ]; }  # waiting for a line
+for _ in $(seq 300); do prompted && break; sleep 0.1; done
+prompted || fail "the console did not prompt"
+sleep 0.5
+kill -INT "$PID_menu"
+wait_pid "$PID_menu" 3; rc=$?
+echo "menu: exit $rc after Ctrl-C"
+[ $rc -eq 0 ] && grep -q "Interrupted" "$WORK/menu.log" || fail "the console did not leave on Ctrl-C: exit $rc"
 
 # Agents that have joined the swarm and read its state.
 for i in $(seq 8); do
