@@ -668,6 +668,20 @@ struct SimServer::Impl {
                    r.min_inter_drone_m, r.min_clearance_m);
     if (changed && r.phase == TaskPhase::kFailed) spdlog::warn("task failed: {}", r.reason);
   }
+  // A tick published again says which agents are live now. Agents that
+  // joined while the swarm was paused at tick 0 read that tick, built before
+  // they were heard, for as long as the pause lasted: each took its drone's
+  // missing DRONE_AGENT_LIVE for a server that does not hear it, and joined
+  // again (agent/agent_app.cpp).
+  void refresh_live_flags() {
+    std::lock_guard<std::mutex> lock(mu);
+    for (std::size_t i = 0; i < std::min<std::size_t>(n, swarm_msg.drones().size()); ++i) {
+      auto& d = swarm_msg.drones()[i];
+      const std::uint16_t others = d.flags() & ~static_cast<std::uint16_t>(msg::DRONE_AGENT_LIVE);
+      d.flags(static_cast<std::uint16_t>(others | (slots[i].live ? msg::DRONE_AGENT_LIVE : 0)));
+    }
+  }
+
   void publish_status(bool force) {
     double now = wall_seconds();
     // Who is live goes out at once: a ground station that has just heard
@@ -838,6 +852,7 @@ struct SimServer::Impl {
       // tick again; a repeat of an answer already in is dropped (kRepeat).
       // Paused, the same write tells late joiners where the swarm is.
       if (wall_seconds() - last_republish > (paused ? 0.25 : cfg.sim.lockstep_resend_s)) {
+        refresh_live_flags();
         w_swarm.write(swarm_msg);
         last_republish = wall_seconds();
         if (!paused) {
