@@ -573,7 +573,7 @@ struct AgentApp::Impl {
         // longer than this agent's lease, or discovery dropped this
         // participant's endpoints): a new participant is discovered afresh.
         for (const auto& b : brains) {
-          if (server_lost || b->unheard_since < 0) continue;
+          if (b->unheard_since < 0) continue;  // heard, or the server went silent since
           const double unheard = wall_seconds() - b->unheard_since;
           if (unheard > 2 * cfg.dds.lease_duration_s) {
             spdlog::warn("{}: the server's samples have marked drone {} agent-less for {:.1f} s while "
