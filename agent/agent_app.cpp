@@ -533,21 +533,13 @@ struct AgentApp::Impl {
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
     else
       spdlog::info("{}: flying drones {}..{} (pid {})", label, brains.front()->id, brains.back()->id, getpid());
-    double last_turn = wall_seconds();
+    LeaseWatch lease(cfg.dds.lease_duration_s, wall_seconds());
     while (!stop_requested() && wall_seconds() < end) {
-      // This loop turns at least every 250 ms. A longer gap than the lease
-      // this participant announces (SIGSTOP, a debugger, a starved machine)
-      // let its peers drop it while it still holds them: Fast DDS 2.9 does
-      // not always recover from such a one-sided loss (an agent stayed deaf
-      // to the server after SIGCONT, docs/faults.md). A new participant is
-      // discovered afresh by everyone.
-      const double now = wall_seconds();
-      const double gap = now - std::exchange(last_turn, now);
-      if (gap > cfg.dds.lease_duration_s) {
-        spdlog::warn(
-            "{}: this process was stopped or starved for {:.1f} s, longer than its DDS lease "
-            "({:.1f} s, dds.lease_duration_s); leaving DDS and joining again as a new participant",
-            label, gap, cfg.dds.lease_duration_s);
+      // This loop turns at least every 250 ms: a longer gap than the lease
+      // means a stop or a starved machine (an agent stayed deaf to the server
+      // after SIGCONT in CI, docs/faults.md).
+      if (const std::string why = lease.turn(wall_seconds()); !why.empty()) {
+        spdlog::warn("{}: {}", label, why);
         return AgentApp::End::kOutlivedLease;
       }
       if (take_rejoin_request()) {

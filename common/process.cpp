@@ -79,6 +79,19 @@ void keep_joining(double duration_s, const std::function<bool(double left_s)>& j
   }
 }
 
+std::string LeaseWatch::turn(double now_s) {
+  const double gap = now_s - last_s_;
+  last_s_ = now_s;
+  if (!(gap > lease_s_)) return "";
+  char line[256];
+  std::snprintf(
+      line, sizeof line,
+      "this process was stopped or starved for %.1f s, longer than its DDS lease (%.1f s, "
+      "dds.lease_duration_s); leaving DDS and joining again as a new participant",
+      gap, lease_s_);
+  return line;
+}
+
 void install_stop_signals() {
   static std::once_flag once;
   std::call_once(once, [] {

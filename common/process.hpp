@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <string>
 
 namespace ddswarm {
 
@@ -33,6 +34,28 @@ bool take_rejoin_request();
 /// returns true to leave and join again as a new participant. Ends when it
 /// returns false, a stop is requested or duration_s (> 0) has passed.
 void keep_joining(double duration_s, const std::function<bool(double left_s)>& join);
+
+/// Notices that this process was stopped (SIGSTOP, Ctrl-Z, a debugger) or
+/// starved for longer than the DDS lease it announces. Its peers may then
+/// have dropped it while it still holds them, and Fast DDS 2.9 does not
+/// always match the two sides again (docs/faults.md): a new participant is
+/// discovered afresh by everyone. A loop that turns often (the agent's, the
+/// recorder's) calls turn() at every turn.
+class LeaseWatch {
+ public:
+  LeaseWatch(double lease_s, double now_s) : lease_s_(lease_s), last_s_(now_s) {}
+  /// Starts a gap here: the time since the last turn was this process's own
+  /// work, not a stop.
+  void restart(double now_s) { last_s_ = now_s; }
+  /// Ends a gap and starts the next. Returns "" or, when the gap was longer
+  /// than the lease, the one-line reason to join again: "this process was
+  /// stopped or starved for 9.7 s, longer than its DDS lease (3.0 s,
+  /// dds.lease_duration_s); leaving DDS and joining again as a new participant".
+  std::string turn(double now_s);
+
+ private:
+  double lease_s_, last_s_;
+};
 
 /// Runs body; maps ConfigError/CLI errors to exit 2, other exceptions to exit 1,
 /// printing "<prog>: error: <what>" on one line.
