@@ -17,8 +17,10 @@ namespace ddswarm::gs {
 class SequenceGaps {
  public:
   using WriterId = std::array<std::uint8_t, 16>;  ///< the writer's GUID
-  /// Records a received sample (each sequence number once).
-  void received(const WriterId& writer, std::uint64_t sequence);
+  /// Records a received sample. False when that writer's number was already
+  /// received: a duplicate, e.g. the transient-local history a reader that
+  /// joined again gets once more. Keep only samples this returns true for.
+  bool received(const WriterId& writer, std::uint64_t sequence);
   /// Samples missing between each writer's lowest and highest number
   /// received: a reader that joined late was owed nothing before its first.
   std::uint64_t missed() const;
@@ -26,8 +28,11 @@ class SequenceGaps {
 
  private:
   struct Span {
-    std::uint64_t lowest, highest, count;
+    std::uint64_t lowest, highest;
+    std::map<std::uint64_t, std::uint64_t> holes;  ///< first -> last number never received
+    std::uint64_t missing = 0;                     ///< numbers in holes
   };
+  static void add_hole(Span& s, std::uint64_t first, std::uint64_t last);
   std::map<WriterId, Span> span_;
 };
 

@@ -31,5 +31,23 @@ TEST(SequenceGaps, AGapFilledLaterIsNoLoss) {
   EXPECT_EQ(g.missed(), 0u);
 }
 
+TEST(SequenceGaps, ADuplicateIsRefusedAndNotCounted) {
+  SequenceGaps g;
+  for (std::uint64_t s : {10, 11, 12, 20}) EXPECT_TRUE(g.received(writer(1), s));
+  EXPECT_EQ(g.missed(), 7u);  // 13-19
+  // A reader that joined again gets the writer's transient-local history once more.
+  for (std::uint64_t s : {10, 11, 12, 20}) EXPECT_FALSE(g.received(writer(1), s));
+  EXPECT_EQ(g.missed(), 7u);
+  EXPECT_TRUE(g.received(writer(1), 15));  // a hole filled in its middle splits it
+  EXPECT_FALSE(g.received(writer(1), 15));
+  EXPECT_EQ(g.missed(), 6u);
+  for (std::uint64_t s : {13, 19, 14, 16, 17, 18}) EXPECT_TRUE(g.received(writer(1), s));
+  EXPECT_EQ(g.missed(), 0u);
+  for (std::uint64_t s = 10; s <= 20; ++s) EXPECT_FALSE(g.received(writer(1), s)) << s;
+  EXPECT_TRUE(g.received(writer(1), 8));  // below the first: new, and 9 is owed now
+  EXPECT_EQ(g.missed(), 1u);
+  EXPECT_TRUE(g.received(writer(2), 12));  // another writer's numbers are its own
+}
+
 }  // namespace
 }  // namespace ddswarm::gs
