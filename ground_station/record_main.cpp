@@ -62,6 +62,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "ddswarm-record: %llu messages, %.2f MB written to %s (peak queue %zu)\n",
                  static_cast<unsigned long long>(total), counts.bytes / 1e6, opt.path.c_str(),
                  counts.max_queue);
+    if (counts.rejoins)
+      std::fprintf(
+          stderr,
+          "ddswarm-record: joined DDS again %d time(s) after a stop longer than the lease; "
+          "%llu samples received twice were kept once\n",
+          counts.rejoins, static_cast<unsigned long long>(counts.duplicates));
     return 0;
   });
 }

@@ -1,17 +1,21 @@
 #include "ground_station/recorder.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
-#include <functional>
-#include <span>
 #include <condition_variable>
+#include <cstring>
 #include <deque>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <set>
+#include <span>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "common/mcap/mcap_reader.hpp"
 #include "common/mcap/mcap_writer.hpp"
@@ -57,8 +61,12 @@ struct Item {
 
 struct Recorder::Impl {
   RecorderOptions opt;
+  DdsConfig dds_cfg;
   mcap::Writer writer;
-  Participant dds;
+  std::unique_ptr<Participant> dds;
+  std::vector<std::function<void(Participant&)>> subscriptions;  // one per recorded topic
+  int rejoins = 0;
+  std::uint64_t duplicates = 0;  // under mu: samples received again after a re-join, kept once
   std::mutex mu;
   std::condition_variable cv;
   std::deque<Item> queue;
@@ -78,10 +86,12 @@ struct Recorder::Impl {
     return w;
   }
 
-  ~Impl() { dds.close(); }
+  ~Impl() {
+    if (dds) dds->close();
+  }
 
   Impl(const DdsConfig& d, RecorderOptions o)
-      : opt(std::move(o)), writer(opt.path, writer_options(opt)), dds(d, "ddswarm-record") {
+      : opt(std::move(o)), dds_cfg(d), writer(opt.path, writer_options(opt)) {
     const auto known = all_topics();
     for (const auto& t : opt.topics)
       if (!known.count(t))
@@ -98,21 +108,38 @@ struct Recorder::Impl {
       channel_topic[channel] = topic;
       written[topic] = 0;
       SequenceGaps* gaps = &gaps_of[topic];
-      dds.reader<T>(
-          [this, channel, gaps](const T& sample, const fdds::SampleInfo& info) {
-            Item it{channel, now_ns(), static_cast<std::uint64_t>(info.source_timestamp.to_ns()), to_cdr(sample)};
-            const auto& guid = info.sample_identity.writer_guid();
-            SequenceGaps::WriterId writer_id;
-            std::copy_n(guid.guidPrefix.value, 12, writer_id.begin());
-            std::copy_n(guid.entityId.value, 4, writer_id.begin() + 12);
-            std::lock_guard<std::mutex> lock(mu);
-            gaps->received(writer_id, info.sample_identity.sequence_number().to64long());
-            queue.push_back(std::move(it));
-            max_queue = std::max(max_queue, queue.size());
-            cv.notify_one();
-          },
-          std::nullopt, Delivery::kArchive);
+      subscriptions.push_back([this, channel, gaps](Participant& p) {
+        p.reader<T>(
+            [this, channel, gaps](const T& sample, const fdds::SampleInfo& info) {
+              Item it{channel, now_ns(), static_cast<std::uint64_t>(info.source_timestamp.to_ns()),
+                      to_cdr(sample)};
+              const auto& guid = info.sample_identity.writer_guid();
+              SequenceGaps::WriterId writer_id;
+              std::copy_n(guid.guidPrefix.value, 12, writer_id.begin());
+              std::copy_n(guid.entityId.value, 4, writer_id.begin() + 12);
+              std::lock_guard<std::mutex> lock(mu);
+              // A re-joined reader gets the transient-local history again.
+              if (!gaps->received(writer_id, info.sample_identity.sequence_number().to64long())) {
+                ++duplicates;
+                return;
+              }
+              queue.push_back(std::move(it));
+              max_queue = std::max(max_queue, queue.size());
+              cv.notify_one();
+            },
+            std::nullopt, Delivery::kArchive);
+      });
     });
+    join();
+  }
+
+  /// A new participant with every reader. The old one, if any, is closed
+  /// first: no callback of it runs afterwards.
+  void join() {
+    if (dds) dds->close();
+    dds.reset();
+    dds = std::make_unique<Participant>(dds_cfg, "ddswarm-record");
+    for (const auto& subscribe : subscriptions) subscribe(*dds);
   }
 
   /// Writes everything queued; false when the queue was empty.
@@ -144,7 +171,19 @@ struct Recorder::Impl {
   RecorderCounts run(double duration_s) {
     const double end = duration_s > 0 ? wall_seconds() + duration_s : 1e300;
     try {
+      LeaseWatch lease(dds_cfg.lease_duration_s, wall_seconds());
       while (!stop_requested() && wall_seconds() < end) {
+        // This loop turns at least every 100 ms plus one drain: a longer gap
+        // than the lease means a stop (Ctrl-Z, SIGSTOP) or a starved machine,
+        // after which a recorder could stay deaf for the rest of its run.
+        if (const std::string why = lease.turn(wall_seconds()); !why.empty()) {
+          spdlog::warn(
+              "ddswarm-record: {}; what no writer kept meanwhile is counted as never received",
+              why);
+          join();
+          ++rejoins;
+          lease.restart(wall_seconds());
+        }
         {
           std::unique_lock<std::mutex> lock(mu);
           cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty(); });
@@ -152,13 +191,13 @@ struct Recorder::Impl {
         drain();
       }
       // Stop listening, then write what arrived before the stop: nothing received is lost.
-      dds.close();
+      dds->close();
       drain();
       writer.close();
     } catch (const std::runtime_error& e) {
       // An I/O failure (disk full, device gone): say exactly what the file
       // holds and what was received but could not be written.
-      dds.close();
+      dds->close();
       std::size_t unwritten;
       {
         std::lock_guard<std::mutex> lock(mu);
@@ -177,6 +216,8 @@ struct Recorder::Impl {
     c.messages = written;
     c.bytes = writer.bytes_written();
     c.max_queue = max_queue;
+    c.rejoins = rejoins;
+    c.duplicates = duplicates;
     for (const auto& [topic, gaps] : gaps_of)
       if (gaps.missed()) c.missed[topic] = gaps.missed();
     return c;

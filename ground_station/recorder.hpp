@@ -28,6 +28,12 @@ struct RecorderCounts {
   /// numbers: best-effort losses, or a KEEP_LAST writer that replaced them
   /// before they were delivered); they are not in the file
   std::map<std::string, std::uint64_t> missed;
+  /// times the recorder left DDS and joined again, having been stopped or
+  /// starved for longer than its lease (dds.lease_duration_s)
+  int rejoins = 0;
+  /// samples received a second time after joining again (the writers'
+  /// transient-local history), kept once
+  std::uint64_t duplicates = 0;
 };
 
 class Recorder {

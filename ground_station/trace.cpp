@@ -17,16 +17,28 @@ namespace ddswarm::gs {
 struct SwarmTrace::Impl {
   FILE* f;
   int every;
+  DdsConfig dds_cfg;
   std::atomic<long> rows{0};
   std::mutex mu;
-  Participant dds;
+  std::optional<std::uint64_t> last_tick;  // under mu
+  std::unique_ptr<Participant> dds;
   Impl(const DdsConfig& d, const std::string& path, int e)
-      : f(std::fopen(path.c_str(), "w")), every(std::max(1, e)), dds(d, "ddswarm-trace") {
+      : f(std::fopen(path.c_str(), "w")), every(std::max(1, e)), dds_cfg(d) {
     if (!f) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
     std::fprintf(f, "tick,sim_time_s,drone,x,y,z,vx,vy,vz,phase,flags,collisions\n");
-    dds.reader<msg::SwarmState>([this](const msg::SwarmState& s, const fdds::SampleInfo&) {
+    join();
+  }
+  /// A new participant and reader; the old one, if any, is closed first.
+  void join() {
+    if (dds) dds->close();
+    dds.reset();
+    dds = std::make_unique<Participant>(dds_cfg, "ddswarm-trace");
+    dds->reader<msg::SwarmState>([this](const msg::SwarmState& s, const fdds::SampleInfo&) {
       if (s.tick() % every) return;
       std::lock_guard<std::mutex> lock(mu);
+      // A lockstep tick published again (a lost answer) is the same tick.
+      if (last_tick == s.tick()) return;
+      last_tick = s.tick();
       for (const auto& d : s.drones()) {
         std::fprintf(f, "%llu,%.3f,%u,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u\n",
                      static_cast<unsigned long long>(s.tick()), s.sim_time_s(), d.drone_id(),
@@ -38,7 +50,7 @@ struct SwarmTrace::Impl {
     });
   }
   ~Impl() {
-    dds.close();  // no callback may write to the file once it is closed
+    dds->close();  // no callback may write to the file once it is closed
     std::lock_guard<std::mutex> lock(mu);
     std::fclose(f);
   }
@@ -48,6 +60,7 @@ SwarmTrace::SwarmTrace(const DdsConfig& dds, const std::string& path, int every)
     : impl_(std::make_unique<Impl>(dds, path, every)) {}
 SwarmTrace::~SwarmTrace() = default;
 long SwarmTrace::rows() const { return impl_->rows; }
+void SwarmTrace::join_again() { impl_->join(); }
 
 std::string SwarmSnapshot::table() const {
   std::string out = fmt::format("tick {} (sim {:.2f} s), {} drones\n", tick, sim_time_s, drones.size());

@@ -21,6 +21,9 @@ class SwarmTrace {
   SwarmTrace(const DdsConfig& dds, const std::string& path, int every);
   ~SwarmTrace();
   long rows() const;
+  /// Leaves DDS and joins again as a new participant (after this process
+  /// outlived its lease: LeaseWatch). A tick already written is not written again.
+  void join_again();
 
  private:
   struct Impl;
