@@ -191,13 +191,13 @@ struct Recorder::Impl {
         drain();
       }
       // Stop listening, then write what arrived before the stop: nothing received is lost.
-      dds->close();
+      if (dds) dds->close();
       drain();
       writer.close();
     } catch (const std::runtime_error& e) {
       // An I/O failure (disk full, device gone): say exactly what the file
       // holds and what was received but could not be written.
-      dds->close();
+      if (dds) dds->close();
       std::size_t unwritten;
       {
         std::lock_guard<std::mutex> lock(mu);

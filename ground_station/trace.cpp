@@ -50,7 +50,7 @@ struct SwarmTrace::Impl {
     });
   }
   ~Impl() {
-    dds->close();  // no callback may write to the file once it is closed
+    if (dds) dds->close();  // no callback may write to the file once it is closed
     std::lock_guard<std::mutex> lock(mu);
     std::fclose(f);
   }
