@@ -15,6 +15,7 @@ void load(YamlSection s, SimConfig& c) {
   s.get("pause_when_idle", c.pause_when_idle);
   s.get("lockstep_pipeline", c.lockstep_pipeline);
   s.get("realtime_grace", c.realtime_grace);
+  s.get("realtime_pipeline", c.realtime_pipeline);
   s.get("lockstep_resend_s", c.lockstep_resend_s);
   s.get("status_rate_hz", c.status_rate_hz);
   s.get("publish_per_drone_topics", c.publish_per_drone_topics);

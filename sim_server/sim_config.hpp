@@ -15,6 +15,8 @@ struct SimConfig {
   bool pause_when_idle = true;          ///< lockstep: hold the clock while every agent is idle
   bool lockstep_pipeline = false;       ///< lockstep: step physics while agents answer; commands act one tick later
   double realtime_grace = 0.25;         ///< realtime: wait up to this fraction of a period past its end for late answers
+  bool realtime_pipeline =
+      false;  ///< realtime: publish on the period's edge, step after; commands act one tick later
   double lockstep_resend_s = 0.25;      ///< s wall, lockstep: publish again if answers are late
   double status_rate_hz = 2.0;          ///< Hz wall, SimStatus publishing
   bool publish_per_drone_topics = true; ///< also publish keyed DroneState/DistanceScan

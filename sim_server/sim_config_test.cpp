@@ -27,6 +27,7 @@ TEST(ServerConfig, TheShippedScenarioLoads) {
   EXPECT_EQ(c.sim.substeps(), 20);
   EXPECT_GE(c.scene.cylinders.size(), 10u);
   EXPECT_FALSE(c.sim.lockstep_pipeline);  // the thesis's lockstep: a command flies the step right after its state
+  EXPECT_FALSE(c.sim.realtime_pipeline);
 }
 
 TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
@@ -38,6 +39,8 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
   EXPECT_EQ(error_for("sim:\n  realtime_grace: 1.5\n"), "2: sim.realtime_grace = 1.5: must be in [0, 0.9]");
   EXPECT_EQ(error_for("sim:\n  lockstep_pipeline: maybe\n"),
             "2: sim.lockstep_pipeline = maybe: must be true or false");
+  EXPECT_EQ(error_for("sim:\n  realtime_pipeline: 2\n"),
+            "2: sim.realtime_pipeline = 2: must be true or false");
   // Lockstep reads its streams reliably whatever dds.best_effort_streams says.
   EXPECT_EQ(error_for("scenario:\n  mode: lockstep\ndds:\n  best_effort_streams: true\n"), "");
   EXPECT_EQ(error_for("dds:\n  best_effort_streams: sometimes\n"),

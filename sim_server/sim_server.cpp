@@ -72,6 +72,7 @@ struct Slot {
   bool has_command = false;
   std::uint64_t command_tick = 0;
   bool answered = false;       // lockstep: answered the current tick
+  bool answered_prev = false;  // real-time pipeline: answered the tick before it
   bool busy = false;
   Phase phase = Phase::kIdle;
   std::uint64_t owner = 0;     // agent instance flying this drone, 0 = none
@@ -101,6 +102,7 @@ struct SimServer::Impl {
   // Lockstep pipeline: physics for tick k -> k+1 runs while the agents answer
   // tick k, with the commands that answered k-1 (latched when k went out).
   const bool pipelined;
+  const bool rt_pipelined;  // sim.realtime_pipeline in real time
   std::vector<Eigen::Vector3d> starts;
   PhysicsWorld world;
   std::vector<FlightController> controllers;
@@ -133,6 +135,8 @@ struct SimServer::Impl {
   // no lock.
   std::atomic<bool> status_due{false};
   int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
+  int unanswered_prev =
+      0;  // real-time pipeline: of those live then, not answered the tick before (same places)
   double agent_d_int = 0;
   // Random per process: Scene and SimStatus carry it, so agents and ground
   // stations tell a restarted server (a new world) from the one they knew.
@@ -172,6 +176,7 @@ struct SimServer::Impl {
         period_s(1.0 / cfg.sim.control_rate_hz),
         dt_s(1.0 / cfg.sim.physics_rate_hz),
         pipelined(cfg.sim.lockstep_pipeline && cfg.scenario.mode == TimeMode::kLockstep),
+        rt_pipelined(cfg.sim.realtime_pipeline && cfg.scenario.mode == TimeMode::kRealtime),
         starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
         world(cfg.scene, cfg.quadrotor, starts, cfg.scene.start.yaw_rad),
         referee(cfg.scene),
@@ -295,7 +300,16 @@ struct SimServer::Impl {
     }
     // Real time: an answer to a state older than the newest arrived after the
     // step it was meant for (it is still the freshest, so it is applied).
-    if (c.tick() < published_tick) counters.commands_late(counters.commands_late() + 1);
+    // Pipelined, that step comes after the next state goes out.
+    if (c.tick() + (rt_pipelined ? 1 : 0) < published_tick)
+      counters.commands_late(counters.commands_late() + 1);
+    // Pipelined real time: a late answer still flies the coming step, but an
+    // answer to the state just published waits for the step after it.
+    if (rt_pipelined && c.tick() < published_tick) latched[c.drone_id()] = view_of(s);
+    if (rt_pipelined && c.tick() + 1 == published_tick && !s.answered_prev) {
+      s.answered_prev = true;
+      if (--unanswered_prev == 0) cv.notify_all();
+    }
     // One wake-up per tick: the main thread needs to run only when the last
     // live agent has answered (it also wakes on its own every 20 ms).
     if (c.tick() == published_tick && !s.answered) {
@@ -328,6 +342,7 @@ struct SimServer::Impl {
       s.owner = instance;
       s.answered = false;
       ++unanswered;
+      s.answered_prev = true;  // owes no answer to a tick published before it was heard
       status_due = true;
     }
     s.last_heard_wall = wall_seconds();
@@ -381,6 +396,8 @@ struct SimServer::Impl {
         s.live = false;
         s.owner = 0;
         if (!s.answered) --unanswered;
+        if (!s.answered_prev) --unanswered_prev;
+        s.answered_prev = true;
         status_due = true;
         counters.lockstep_timeouts(counters.lockstep_timeouts() + 1);
         spdlog::warn("drone {}: agent lost (silent for {:.1f} s); drone enters failsafe", i,
@@ -430,11 +447,12 @@ struct SimServer::Impl {
   double sim_time() const { return static_cast<double>(tick) * period_s; }
 
   /// Chooses each drone's setpoint for the coming period: from the latest
-  /// answers, or (pipelined) from those latched when the tick went out. Call with mu held.
+  /// answers, or (pipelined) from those latched when the tick went out (in
+  /// real time, with the late answers to the ticks before). Call with mu held.
   void select_setpoints() {
     const double t = sim_time();
     for (int i = 0; i < n; ++i) {
-      const CommandView s = pipelined ? latched[i] : view_of(slots[i]);
+      const CommandView s = pipelined || rt_pipelined ? latched[i] : view_of(slots[i]);
       bool fresh = s.has_command && s.live &&
                    (static_cast<double>(tick - std::min(tick, s.command_tick)) * period_s <=
                     cfg.sim.command_timeout_s);
@@ -564,9 +582,12 @@ struct SimServer::Impl {
       pending_beacons.clear();
       published_tick = tick;
       unanswered = 0;
+      unanswered_prev = 0;
       for (int i = 0; i < n; ++i) {
         Slot& s = slots[i];
-        if (pipelined) latched[i] = view_of(s);
+        if (pipelined || rt_pipelined) latched[i] = view_of(s);
+        s.answered_prev = s.answered;
+        unanswered_prev += s.live && !s.answered;
         s.answered = false;
         unanswered += s.live;
       }
@@ -776,11 +797,20 @@ struct SimServer::Impl {
     return true;
   }
 
+  /// Real time: each period, wait up to the grace for live agents' late
+  /// answers, then step and publish. Pipelined (sim.realtime_pipeline), each
+  /// state goes out on its period's edge, computed by the step before; then
+  /// the world steps with the answers to the state before it, waiting up to
+  /// the grace for late ones. An agent has a whole period plus the grace to
+  /// answer, instead of the period less the step; every command acts one
+  /// period later.
   void run_realtime(double deadline_wall) {
     state_text = "running";
     publish_tick();
+    if (rt_pipelined) step();
     auto next = Clock::now();
-    const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
+    const auto period =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
     const auto grace = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(period_s * cfg.sim.realtime_grace));
     while (!stop_requested() && !rejoin_now() && wall_seconds() < deadline_wall) {
@@ -792,15 +822,20 @@ struct SimServer::Impl {
         next = now;
       }
       std::this_thread::sleep_until(next);
+      if (rt_pipelined) publish_next();
       {
         std::unique_lock<std::mutex> lock(mu);
         expire_agents();
         // A live agent a little late (descheduled for a moment) still gets
         // its answer into this step; the deadline of the next period stays.
-        if (unanswered > 0 && grace.count() > 0)
-          cv.wait_until(lock, next + grace, [&] { return unanswered == 0 || stop_requested(); });
+        int& waiting = rt_pipelined ? unanswered_prev : unanswered;
+        if (waiting > 0 && grace.count() > 0)
+          cv.wait_until(lock, next + grace, [&] { return waiting == 0 || stop_requested(); });
       }
-      advance();
+      if (rt_pipelined)
+        step();
+      else
+        advance();
     }
   }
 
@@ -868,10 +903,11 @@ struct SimServer::Impl {
     start_wall = wall_seconds();
     rtf_wall = start_wall;
     double deadline = duration_s > 0 ? start_wall + duration_s : 1e300;
-    spdlog::info("ddswarm-sim: scenario '{}', {} drones, {} mode{}, physics {} Hz, control {} Hz, seed {}",
-                 cfg.scenario.name, n, to_string(cfg.scenario.mode),
-                 pipelined ? " (pipelined: commands act one tick later)" : "", cfg.sim.physics_rate_hz,
-                 cfg.sim.control_rate_hz, cfg.scenario.seed);
+    spdlog::info(
+        "ddswarm-sim: scenario '{}', {} drones, {} mode{}, physics {} Hz, control {} Hz, seed {}",
+        cfg.scenario.name, n, to_string(cfg.scenario.mode),
+        pipelined || rt_pipelined ? " (pipelined: commands act one tick later)" : "",
+        cfg.sim.physics_rate_hz, cfg.sim.control_rate_hz, cfg.scenario.seed);
     if (cfg.scenario.mode == TimeMode::kLockstep)
       run_lockstep(deadline);
     else
