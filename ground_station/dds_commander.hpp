@@ -18,6 +18,9 @@ namespace ddswarm::gs {
 struct TaskOutcome {
   bool ok = false;
   std::string reason;
+  /// failed before the swarm was up (the server never heard every agent):
+  /// a start-up failure, not a result of the task
+  bool never_up = false;
   double task_time_s = 0;    ///< s sim
   double wall_time_s = 0;    ///< s wall
   double epsilon_m = 0;

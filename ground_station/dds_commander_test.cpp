@@ -3,8 +3,9 @@
 // before it matches the server, and the server releases a command only to
 // the agents it hears (an experiment run once failed so: "takeoff 5/6
 // acknowledged; no ack from drones 0").
-#include <gtest/gtest.h>
+#include "ground_station/dds_commander.hpp"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -13,7 +14,7 @@
 
 #include "common/participant.hpp"
 #include "common/process.hpp"
-#include "ground_station/dds_commander.hpp"
+#include "ground_station/experiment.hpp"
 
 namespace ddswarm::gs {
 namespace {
@@ -100,6 +101,31 @@ TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
   EXPECT_LT(wall_seconds() - t0, 2.0);
   EXPECT_GE(asked.load(), 3);
   EXPECT_FALSE(gs.wait_for_swarm(6, 0.3, [] { return false; }));  // a plain timeout still is one
+}
+
+// A run whose swarm never came up (CI once: the server heard none of six
+// agents the ground station heard) is a start-up failure: the experiment
+// starts it again, up to kRunStarts times; any other failure is its result.
+TEST(Experiment, ARunWhoseSwarmNeverCameUpStartsAgain) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  DdsCommander gs(GroundStationConfig{}, cfg);  // no swarm at all
+  const TaskOutcome o = fly_task(
+      gs, 6, TaskConfig{}, nullptr, [] { return false; }, 0.3);
+  EXPECT_FALSE(o.ok);
+  EXPECT_TRUE(o.never_up);
+  EXPECT_EQ(o.reason, "only 0/6 agents online (0 heard by the server) after 0.3 s");
+  EXPECT_TRUE(start_run_again(o, false, 1));
+  EXPECT_TRUE(start_run_again(o, false, kRunStarts - 1));
+  EXPECT_FALSE(start_run_again(o, false, kRunStarts));
+  EXPECT_FALSE(start_run_again(o, true, 1));  // a process died: that is the run's result
+  const TaskOutcome died = fly_task(
+      gs, 6, TaskConfig{}, nullptr, [] { return true; }, 0.3);
+  EXPECT_FALSE(died.never_up);
+  EXPECT_FALSE(start_run_again(died, false, 1));
+  TaskOutcome refused;
+  refused.reason = "task: refused";
+  EXPECT_FALSE(start_run_again(refused, false, 1));
 }
 
 }  // namespace

@@ -24,16 +24,18 @@ namespace fs = std::filesystem;
 
 TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
                      const std::function<void(const std::string&)>& progress,
-                     const std::function<bool()>& give_up) {
+                     const std::function<bool()>& give_up, double swarm_wait_s) {
   TaskOutcome fail;
-  if (!gs.wait_for_swarm(drones, 30.0, give_up)) {
+  if (!gs.wait_for_swarm(drones, swarm_wait_s, give_up)) {
     if (give_up && give_up()) {
       fail.reason = "a process of the run ended before the swarm was up";
       return fail;
     }
     auto st = gs.status();
-    fail.reason = fmt::format("only {}/{} agents online ({} heard by the server) after 30 s", st.drones_online,
-                              drones, std::max(st.drones_server_hears, 0));
+    fail.reason =
+        fmt::format("only {}/{} agents online ({} heard by the server) after {:g} s",
+                    st.drones_online, drones, std::max(st.drones_server_hears, 0), swarm_wait_s);
+    fail.never_up = true;
     return fail;
   }
   auto r = gs.takeoff(0);
@@ -212,8 +214,13 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
     }
     TaskOutcome o;
     std::string died;
-    {
-      Launcher procs(opt.out_dir + "/logs/" + p.tag);
+    // A run whose swarm never came up starts again: that is a start-up
+    // failure, not a result (start_run_again).
+    for (int starts = 1;; ++starts) {
+      o = TaskOutcome{};
+      died.clear();
+      Launcher procs(opt.out_dir + "/logs/" + p.tag +
+                     (starts > 1 ? ".start" + std::to_string(starts) : ""));
       auto common_args = [&](std::vector<std::string> a) {
         a.push_back("--domain");
         a.push_back(std::to_string(domain));
@@ -268,7 +275,12 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       watchdog.join();
       const double stop_start = wall_seconds();
       procs.stop_all(3.0);
-      times.teardown_s = wall_seconds() - stop_start;
+      times.teardown_s += wall_seconds() - stop_start;
+      if (stop_requested() || !start_run_again(o, !died.empty(), starts)) break;
+      std::lock_guard<std::mutex> lock(mu);
+      out << fmt::format("  {}: {}; starting the run again ({} of {})", p.tag, o.reason, starts + 1,
+                         kRunStarts)
+          << std::endl;
     }
     rec.ok = o.ok && died.empty();
     rec.failure_reason = !died.empty() ? died : o.reason;

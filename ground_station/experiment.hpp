@@ -15,10 +15,22 @@ namespace ddswarm::gs {
 /// Waits for `drones` agents, takes off, waits until airborne, starts the
 /// task and waits for its result. Failures come back as an outcome with a reason.
 /// give_up (optional) ends the wait for the swarm at once, e.g. when a
-/// process of the run has died.
+/// process of the run has died. A swarm not up within swarm_wait_s fails
+/// with never_up set.
 TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
                      const std::function<void(const std::string&)>& progress,
-                     const std::function<bool()>& give_up = {});
+                     const std::function<bool()>& give_up = {}, double swarm_wait_s = 30.0);
+
+/// Times an experiment starts a run whose swarm never came up, before it
+/// records the run as failed.
+inline constexpr int kRunStarts = 3;
+/// Whether to start a run again: its swarm never came up (a discovery
+/// failure of Fast DDS, seen once in CI-like runs: the server heard none of
+/// six agents that the ground station heard), no process of it died, and it
+/// has starts left. A lockstep run's result depends on its seed alone.
+inline bool start_run_again(const TaskOutcome& o, bool a_process_died, int starts) {
+  return o.never_up && !a_process_died && starts < kRunStarts;
+}
 
 struct ExperimentOptions {
   std::string out_dir = "results";  ///< CSV, table, plots, per-run scenarios and logs go here
