@@ -270,17 +270,7 @@ int main(int argc, char** argv) {
 
     if (*trace) {
       SwarmTrace t(file.dds, trace_out, trace_every);
-      const double end = wall_seconds() + (trace_duration > 0 ? trace_duration : 1e9);
-      LeaseWatch lease(file.dds.lease_duration_s, wall_seconds());
-      while (!wait_for_stop(std::chrono::duration<double>(std::min(0.25, end - wall_seconds()))) &&
-             wall_seconds() < end) {
-        // Stopped (Ctrl-Z) longer than the lease, a trace could stay deaf.
-        if (const std::string why = lease.turn(wall_seconds()); !why.empty()) {
-          spdlog::warn("ddswarm-gs trace: {}", why);
-          t.join_again();
-          lease.restart(wall_seconds());
-        }
-      }
+      t.run(trace_duration);
       std::printf("%ld rows written to %s\n", t.rows(), trace_out.c_str());
       return 0;
     }

@@ -1,16 +1,20 @@
 #include "ground_station/trace.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
-#include <limits>
+#include <chrono>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 
 #include "common/convert.hpp"
 #include "common/mission.hpp"
 #include "common/participant.hpp"
+#include "common/process.hpp"
 
 namespace ddswarm::gs {
 
@@ -30,8 +34,7 @@ struct SwarmTrace::Impl {
   }
   /// A new participant and reader; the old one, if any, is closed first.
   void join() {
-    if (dds) dds->close();
-    dds.reset();
+    dds.reset();  // the old participant leaves before the new one joins
     dds = std::make_unique<Participant>(dds_cfg, "ddswarm-trace");
     dds->reader<msg::SwarmState>([this](const msg::SwarmState& s, const fdds::SampleInfo&) {
       if (s.tick() % every) return;
@@ -60,7 +63,18 @@ SwarmTrace::SwarmTrace(const DdsConfig& dds, const std::string& path, int every)
     : impl_(std::make_unique<Impl>(dds, path, every)) {}
 SwarmTrace::~SwarmTrace() = default;
 long SwarmTrace::rows() const { return impl_->rows; }
-void SwarmTrace::join_again() { impl_->join(); }
+void SwarmTrace::run(double duration_s) {
+  const double end = wall_seconds() + (duration_s > 0 ? duration_s : 1e9);
+  LeaseWatch lease(impl_->dds_cfg.lease_duration_s, wall_seconds());
+  while (!wait_for_stop(std::chrono::duration<double>(std::min(0.25, end - wall_seconds()))) &&
+         wall_seconds() < end) {
+    if (const std::string why = lease.turn(wall_seconds()); !why.empty()) {
+      spdlog::warn("ddswarm-gs trace: {}", why);
+      impl_->join();
+      lease.restart(wall_seconds());
+    }
+  }
+}
 
 std::string SwarmSnapshot::table() const {
   std::string out = fmt::format("tick {} (sim {:.2f} s), {} drones\n", tick, sim_time_s, drones.size());

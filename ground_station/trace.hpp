@@ -21,9 +21,11 @@ class SwarmTrace {
   SwarmTrace(const DdsConfig& dds, const std::string& path, int every);
   ~SwarmTrace();
   long rows() const;
-  /// Leaves DDS and joins again as a new participant (after this process
-  /// outlived its lease: LeaseWatch). A tick already written is not written again.
-  void join_again();
+  /// Traces until stop_requested() or duration_s (<= 0: until stopped). A
+  /// process stopped (Ctrl-Z) longer than its DDS lease could stay deaf, so
+  /// then it leaves DDS and joins again as a new participant (LeaseWatch);
+  /// a tick already written is not written again.
+  void run(double duration_s);
 
  private:
   struct Impl;
