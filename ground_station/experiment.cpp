@@ -217,7 +217,6 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
     // A run whose swarm never came up starts again: that is a start-up
     // failure, not a result (start_run_again).
     for (int starts = 1;; ++starts) {
-      o = TaskOutcome{};
       died.clear();
       Launcher procs(opt.out_dir + "/logs/" + p.tag +
                      (starts > 1 ? ".start" + std::to_string(starts) : ""));

@@ -136,8 +136,7 @@ struct Recorder::Impl {
   /// A new participant with every reader. The old one, if any, is closed
   /// first: no callback of it runs afterwards.
   void join() {
-    if (dds) dds->close();
-    dds.reset();
+    dds.reset();  // the old participant leaves before the new one joins
     dds = std::make_unique<Participant>(dds_cfg, "ddswarm-record");
     for (const auto& subscribe : subscriptions) subscribe(*dds);
   }

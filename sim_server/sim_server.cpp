@@ -135,8 +135,9 @@ struct SimServer::Impl {
   // no lock.
   std::atomic<bool> status_due{false};
   int unanswered = 0;  // live slots that have not answered published_tick (kept by the four places that change them)
-  int unanswered_prev =
-      0;  // real-time pipeline: of those live then, not answered the tick before (same places)
+  // Real-time pipeline: of the slots live at the publish, those that have not
+  // answered the tick before it (kept by the same four places).
+  int unanswered_prev = 0;
   double agent_d_int = 0;
   // Random per process: Scene and SimStatus carry it, so agents and ground
   // stations tell a restarted server (a new world) from the one they knew.
