@@ -43,6 +43,7 @@ void load(YamlSection s, DdsConfig& c) {
   s.get("peers", c.peers);
   s.get("discovery_server", c.discovery_server);
   s.get("shared_memory", c.shared_memory);
+  s.get("shm_transport", c.shm_transport);
   s.get("participant_id", c.participant_id);
   s.get("lease_duration_s", c.lease_duration_s);
   s.get("profiles_file", c.profiles_file);

@@ -46,7 +46,12 @@ struct DdsConfig {
   std::string interface_ip;           ///< kInterface/kPeers: the local address to use, e.g. 10.10.0.2
   std::vector<std::string> peers;     ///< kPeers: peer addresses "ip" (or "ip:port" for one port)
   std::string discovery_server;       ///< kDiscoveryServer: "ip:port" (port default 11811)
-  bool shared_memory = true;          ///< add the SHM transport (same host only)
+  bool shared_memory = true;          ///< use /dev/shm (see shm_transport)
+  /// With shared_memory: add Fast DDS's shared-memory transport too. false
+  /// keeps data-sharing delivery (the swarm state) and sends every other
+  /// sample (velocity commands, statuses, missions) over UDP on 127.0.0.1;
+  /// 128 real-time agents then missed fewer commands (docs/performance.md).
+  bool shm_transport = true;
   int participant_id = -1;            ///< RTPS participant id, -1 = automatic; set explicitly past ~100 participants per host
                                       ///< (at most max_participant_id(domain_id): the RTPS ports must fit)
   double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement

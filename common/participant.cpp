@@ -86,6 +86,11 @@ bool uses_shared_memory(const DdsConfig& cfg) {
   return cfg.shared_memory && !cfg.secure() && kShmAllowed;
 }
 
+/// Whether it adds the shared-memory transport, besides data-sharing delivery.
+bool uses_shm_transport(const DdsConfig& cfg) {
+  return uses_shared_memory(cfg) && cfg.shm_transport;
+}
+
 /// Builds participant QoS whose every transport is bound to what cfg allows.
 fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& name) {
   fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
@@ -147,7 +152,7 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
   // Give the initial-peers scan room for a large swarm on one host.
   udp->maxInitialPeersRange = kInitialPeersRange;
 
-  if (uses_shared_memory(cfg)) {
+  if (uses_shm_transport(cfg)) {
     auto shm = std::make_shared<SharedMemTransportDescriptor>();
     shm->segment_size(4 * 1024 * 1024);
     qos.transport().user_transports.push_back(shm);
@@ -203,7 +208,7 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     // An automatic id whose shared-memory ports no process left behind: a
     // server restarted after a SIGKILL came up on its dead predecessor's
     // ports, and the agents kept sending into the old ones (shm_clean.hpp).
-    const bool clear_id = cfg.participant_id < 0 && uses_shared_memory(cfg);
+    const bool clear_id = cfg.participant_id < 0 && uses_shm_transport(cfg);
     if (clear_id)
       qos.wire_protocol().participant_id = participant_id_clear_of_shm(
           cfg.domain_id, std::min(kInitialPeersRange - 1, max_participant_id(cfg.domain_id)));

@@ -180,5 +180,29 @@ TEST(Participant, SwarmStateUsesSharedMemoryOnlyWhenAllowed) {
   local.close();
 }
 
+// dds.shm_transport: false keeps data-sharing delivery of the swarm state
+// and leaves out Fast DDS's shared-memory transport, whose ports are files in
+// /dev/shm named by the RTPS port: every other sample then goes over UDP.
+TEST(Participant, WithoutTheShmTransportTheSwarmStateStillComesByDataSharing) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.participant_id = 100 + static_cast<int>(random_instance() % 100);
+  const std::filesystem::path port =
+      "/dev/shm/fastrtps_port" +
+      std::to_string(rtps_unicast_port(cfg.domain_id, cfg.participant_id));
+  const auto no_handler = [](const msg::SwarmState&, const fdds::SampleInfo&) {};
+  cfg.shm_transport = false;
+  {
+    Participant without(cfg, "participant_test");
+    without.reader<msg::SwarmState>(no_handler);
+    EXPECT_FALSE(std::filesystem::exists(port)) << port;
+    // The reader's data-sharing segment (the TSan build never uses shared memory).
+    EXPECT_EQ(data_sharing_pools_of(without), without.shared_memory() ? 1u : 0u);
+  }
+  cfg.shm_transport = true;
+  Participant with(cfg, "participant_test");
+  EXPECT_EQ(std::filesystem::exists(port), with.shared_memory()) << port;
+}
+
 }  // namespace
 }  // namespace ddswarm

@@ -45,6 +45,9 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
   EXPECT_EQ(error_for("scenario:\n  mode: lockstep\ndds:\n  best_effort_streams: true\n"), "");
   EXPECT_EQ(error_for("dds:\n  best_effort_streams: sometimes\n"),
             "2: dds.best_effort_streams = sometimes: must be true or false");
+  EXPECT_EQ(error_for("dds:\n  shm_transport: false\n"), "");
+  EXPECT_EQ(error_for("dds:\n  shm_transport: udp\n"),
+            "2: dds.shm_transport = udp: must be true or false");
   EXPECT_EQ(error_for("sim:\n  colour: red\n"), "2: sim.colour: unknown key");
   EXPECT_EQ(error_for("wings: 2\n"), "1: wings: unknown section");
   EXPECT_EQ(error_for("sensors:\n  count: many\n"), "2: sensors.count = many: must be an integer");
