@@ -3,15 +3,16 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <condition_variable>
+#include <deque>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <random>
-#include <utility>
-#include <deque>
-#include <map>
 #include <set>
+#include <utility>
 
 #include "agent/comm_model.hpp"
 #include "agent/mission_fsm.hpp"
@@ -148,6 +149,7 @@ struct AgentApp::Impl {
   std::uint64_t last_tick = 0;
   bool have_tick = false;
   double last_sample_wall = -1e9;
+  double scene_wall = -1e9;  // when the server's scene came (wall)
   bool server_lost = false;
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
   std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
@@ -163,8 +165,12 @@ struct AgentApp::Impl {
   std::optional<Delivery> states_wanted;
   std::condition_variable woke;
 
-  // The run loop's own: the swarm-state reader and how it reads.
+  // The run loop's own: the swarm-state reader and how it reads, and the
+  // scene reader, whose match says the server's participant is alive.
   Reader<msg::SwarmState>* states = nullptr;
+  Reader<msg::Scene>* scenes = nullptr;
+  bool scene_matched = false;        // the scene writer was matched at the last turn
+  double scene_matched_wall = -1e9;  // since when, this time
   Delivery states_delivery = Delivery::kProfile;
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
@@ -199,7 +205,7 @@ struct AgentApp::Impl {
       it->second->rival = s.agent_instance();
       it->second->rival_where = s.host().to_string() + " pid " + std::to_string(s.pid());
     });
-    dds.reader<msg::Scene>([this](const msg::Scene& s, const fdds::SampleInfo& info) {
+    scenes = &dds.reader<msg::Scene>([this](const msg::Scene& s, const fdds::SampleInfo& info) {
       std::lock_guard<std::mutex> lock(mu);
       on_scene(s, info.sample_identity.writer_guid().guidPrefix);
     });
@@ -250,6 +256,7 @@ struct AgentApp::Impl {
       return;
     }
     if (scene && s.server_instance() == server_instance) return;  // a re-announcement: keep the mission
+    scene_wall = wall_seconds();
     if (scene) {
       // A restarted server is a new world: the drone is back at its start,
       // so the old mission no longer applies. Start over and catch up with
@@ -573,6 +580,29 @@ struct AgentApp::Impl {
                          "and joining again as a new participant",
                          label, b->id, unheard);
             return AgentApp::End::kUnheard;
+          }
+        }
+        // Deaf to a live server: its scene writer is still matched, yet no
+        // swarm state came for twice the lease. A live server publishes at
+        // least every 0.25 s (lockstep resends, a paused swarm), and one
+        // stopped longer than its lease is dropped with its writers, so this
+        // is a reader that lost or never matched the server's swarm-state
+        // writer: a new participant is discovered afresh. The count starts
+        // again when the server is matched again: one that was away longer
+        // than its lease comes back a moment before its states.
+        const bool matched = scenes && scenes->matched() > 0;
+        if (matched && !scene_matched) scene_matched_wall = wall_seconds();
+        scene_matched = matched;
+        if (scene && matched) {
+          const double deaf =
+              wall_seconds() - std::max({last_sample_wall, scene_wall, scene_matched_wall});
+          if (deaf > 2 * cfg.dds.lease_duration_s) {
+            spdlog::warn(
+                "{}: no swarm state from the server for {:.1f} s while its scene writer is "
+                "still matched: this participant does not hear the server; leaving DDS and "
+                "joining again as a new participant",
+                label, deaf);
+            return AgentApp::End::kDeaf;
           }
         }
         // Fast DDS 2.9 sometimes never matches one of 128 participants that

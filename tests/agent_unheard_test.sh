@@ -45,5 +45,9 @@ sleep 9
 if grep -h "does not hear this agent" "$WORK/agent0b.log" "$WORK/agent1b.log"; then
   fail "an agent of the paused lockstep swarm took itself for unheard"
 fi
+# Nor for deaf: a paused lockstep server publishes its tick again every 0.25 s.
+if grep -h "does not hear the server" "$WORK/agent0b.log" "$WORK/agent1b.log"; then
+  fail "an agent of the paused lockstep swarm took itself for deaf"
+fi
 echo "paused lockstep swarm: both agents stayed for 9 s"
 echo PASS
