@@ -65,3 +65,24 @@ wait_pid() {
 }
 
 fail() { echo "FAIL: $*"; exit 1; }
+
+# fly_six_realtime ARGS...: ddswarm-launch of the thesis scenario in real
+# time with ARGS (logs in $WORK), every agent online and the swarm airborne.
+# gs runs the ground station on the test's domain.
+fly_six_realtime() {
+  scenario="$SRC/config/thesis_course.yaml"
+  start launch "$BIN/ddswarm-launch" "$scenario" --mode realtime --domain "$DOMAIN" "$@" --log-dir "$WORK"
+  gs wait-agents --count 6 --timeout 60 || fail "agents not online"
+  gs takeoff --wait || fail "takeoff"
+}
+gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
+
+# probe_swarm N: 5 s of swarm_probe --ages on a flying swarm of N, printed;
+# probe_val KEY then prints one of its figures (rtf, age_p99_periods, ...).
+probe_swarm() {
+  timeout 60 "$BIN/swarm_probe" --drones "$1" --settle 1 --time 5 --ages --domain "$DOMAIN" \
+    >"$WORK/probe.out" 2>&1
+  cat "$WORK/probe.out"
+  PROBE_LINE=$(grep "^probe ok=1" "$WORK/probe.out") || fail "the probe did not measure the swarm"
+}
+probe_val() { echo "$PROBE_LINE" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
