@@ -169,8 +169,6 @@ struct AgentApp::Impl {
   // scene reader, whose match says the server's participant is alive.
   Reader<msg::SwarmState>* states = nullptr;
   Reader<msg::Scene>* scenes = nullptr;
-  bool scene_matched = false;        // the scene writer was matched at the last turn
-  double scene_matched_wall = -1e9;  // since when, this time
   Delivery states_delivery = Delivery::kProfile;
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
@@ -590,12 +588,9 @@ struct AgentApp::Impl {
         // writer: a new participant is discovered afresh. The count starts
         // again when the server is matched again: one that was away longer
         // than its lease comes back a moment before its states.
-        const bool matched = scenes && scenes->matched() > 0;
-        if (matched && !scene_matched) scene_matched_wall = wall_seconds();
-        scene_matched = matched;
-        if (scene && matched) {
+        if (scene && scenes->matched() > 0) {
           const double deaf =
-              wall_seconds() - std::max({last_sample_wall, scene_wall, scene_matched_wall});
+              wall_seconds() - std::max({last_sample_wall, scene_wall, scenes->matched_since()});
           if (deaf > 2 * cfg.dds.lease_duration_s) {
             spdlog::warn(
                 "{}: no swarm state from the server for {:.1f} s while its scene writer is "

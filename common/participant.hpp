@@ -3,6 +3,7 @@
 //
 // The participant's transports come from DdsConfig (localhost-only unless the
 // user opts in); QoS comes from the XML profiles named in common/topics.hpp.
+#include <atomic>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
@@ -12,7 +13,6 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
-#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -22,6 +22,7 @@
 #include <string>
 
 #include "common/dds_config.hpp"
+#include "common/process.hpp"
 #include "common/topics.hpp"
 
 namespace ddswarm {
@@ -79,6 +80,10 @@ class Reader : public fdds::DataReaderListener {
   void attach(fdds::DataReader* r) { r_ = r; }
   fdds::DataReader* raw() const { return r_; }
   int matched() const { return matched_.load(); }
+  /// wall_seconds() when the matched writers last went from none to some
+  /// (-1e9 before the first match): a writer back after its participant was
+  /// dropped counts from then.
+  double matched_since() const { return matched_since_.load(); }
 
   void on_data_available(fdds::DataReader* reader) override {
     // One sample object, reused: deserializing into it keeps its sequences'
@@ -90,6 +95,7 @@ class Reader : public fdds::DataReaderListener {
     }
   }
   void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {
+    if (s.current_count > 0 && matched_.load() == 0) matched_since_ = wall_seconds();
     matched_ = s.current_count;
   }
 
@@ -97,6 +103,7 @@ class Reader : public fdds::DataReaderListener {
   SampleHandler<T> handler_;
   fdds::DataReader* r_ = nullptr;
   std::atomic<int> matched_{0};
+  std::atomic<double> matched_since_{-1e9};
   std::mutex sample_mu_;  // transports' receive threads may deliver at once
   T sample_;
 };

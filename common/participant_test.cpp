@@ -180,6 +180,36 @@ TEST(Participant, SwarmStateUsesSharedMemoryOnlyWhenAllowed) {
   local.close();
 }
 
+// An agent tells a live server from one that was away by when the server's
+// writer was matched again: matched_since() moves only when the count rises
+// from none.
+TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant agent(cfg, "participant_test reader");
+  auto& r = agent.reader<msg::Scene>([](const msg::Scene&, const fdds::SampleInfo&) {});
+  EXPECT_LT(r.matched_since(), 0);
+  const double before = wall_seconds();
+  double first = 0;
+  {
+    Participant server(cfg, "participant_test writer");
+    auto w = server.writer<msg::Scene>();
+    ASSERT_TRUE(within(10, [&] { return r.matched() == 1 && w.matched() == 1; }));
+    first = r.matched_since();
+    EXPECT_GE(first, before);
+    Participant other(cfg, "participant_test second writer");
+    auto w2 = other.writer<msg::Scene>();
+    ASSERT_TRUE(within(10, [&] { return r.matched() == 2 && w2.matched() == 1; }));
+    EXPECT_EQ(r.matched_since(), first);  // more writers: still matched since then
+  }
+  ASSERT_TRUE(within(10, [&] { return r.matched() == 0; }));
+  Participant again(cfg, "participant_test writer again");
+  auto w = again.writer<msg::Scene>();
+  ASSERT_TRUE(within(10, [&] { return r.matched() == 1 && w.matched() == 1; }));
+  EXPECT_GT(r.matched_since(), first);
+  agent.close();
+}
+
 // dds.shm_transport: false keeps data-sharing delivery of the swarm state
 // and leaves out Fast DDS's shared-memory transport, whose ports are files in
 // /dev/shm named by the RTPS port: every other sample then goes over UDP.
