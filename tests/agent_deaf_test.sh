@@ -10,14 +10,7 @@ source "$(dirname "$0")/lib.sh"
 scenario="$SRC/config/thesis_course.yaml"
 # The shipped profiles, with EXCLUSIVE ownership on the swarm-state reader
 # only (the server's writer is SHARED: no match).
-/usr/bin/python3 - "$SRC/config/dds_profiles.xml" "$WORK/deaf_profiles.xml" <<'PY'
-import re, sys
-xml = open(sys.argv[1]).read()
-pat = r'(<data_reader profile_name="state">.*?<qos>)'
-xml, n = re.subn(pat, r'\1<ownership><kind>EXCLUSIVE</kind></ownership>', xml, count=1, flags=re.S)
-assert n == 1
-open(sys.argv[2], "w").write(xml)
-PY
+unmatched_profiles "$WORK/deaf_profiles.xml" data_reader:state || fail "profiles"
 start sim "$BIN/ddswarm-sim" --scenario "$scenario" --drones 2 --mode realtime --domain "$DOMAIN"
 start agent0 "$BIN/ddswarm-agent" --id 0 --drones 2 --config "$scenario" --domain "$DOMAIN" \
   --dds-profiles "$WORK/deaf_profiles.xml"

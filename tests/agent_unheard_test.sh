@@ -9,15 +9,7 @@ source "$(dirname "$0")/lib.sh"
 scenario="$SRC/config/thesis_course.yaml"
 # The shipped profiles, with EXCLUSIVE ownership on the agent's command and
 # heartbeat writers only (the server's readers are SHARED: no match).
-/usr/bin/python3 - "$SRC/config/dds_profiles.xml" "$WORK/deaf_profiles.xml" <<'PY'
-import re, sys
-xml = open(sys.argv[1]).read()
-for name in ("command", "heartbeat"):
-    pat = r'(<data_writer profile_name="%s">.*?<qos>)' % name
-    xml, n = re.subn(pat, r'\1<ownership><kind>EXCLUSIVE</kind></ownership>', xml, count=1, flags=re.S)
-    assert n == 1, name
-open(sys.argv[2], "w").write(xml)
-PY
+unmatched_profiles "$WORK/deaf_profiles.xml" data_writer:command data_writer:heartbeat || fail "profiles"
 start sim "$BIN/ddswarm-sim" --scenario "$scenario" --drones 2 --mode realtime --domain "$DOMAIN"
 start agent0 "$BIN/ddswarm-agent" --id 0 --drones 2 --config "$scenario" --domain "$DOMAIN" \
   --dds-profiles "$WORK/deaf_profiles.xml"

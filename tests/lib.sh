@@ -86,3 +86,19 @@ probe_swarm() {
   PROBE_LINE=$(grep "^probe ok=1" "$WORK/probe.out") || fail "the probe did not measure the swarm"
 }
 probe_val() { echo "$PROBE_LINE" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
+
+# unmatched_profiles OUT ENDPOINT:PROFILE...: the shipped QoS profiles with
+# EXCLUSIVE ownership on each named endpoint (e.g. data_writer:command), so
+# it matches none of the swarm's SHARED peers; written to OUT.
+unmatched_profiles() {
+  /usr/bin/python3 - "$SRC/config/dds_profiles.xml" "$@" <<'PY'
+import re, sys
+xml = open(sys.argv[1]).read()
+for spec in sys.argv[3:]:
+    kind, name = spec.split(":")
+    pat = r'(<%s profile_name="%s">.*?<qos>)' % (kind, name)
+    xml, n = re.subn(pat, r'\1<ownership><kind>EXCLUSIVE</kind></ownership>', xml, count=1, flags=re.S)
+    assert n == 1, spec
+open(sys.argv[2], "w").write(xml)
+PY
+}
