@@ -154,6 +154,7 @@ struct AgentApp::Impl {
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
   std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
   bool loss_logged = false;    // agent.state_loss said so in the log
+  bool copy_logged = false;    // a copied scene was refused, and the log said so
   // This tick's swarm members (live agent, not in failsafe, finite position),
   // by id: converted once per sample for every brain in the process.
   std::vector<PeerObservation> roster;
@@ -247,6 +248,18 @@ struct AgentApp::Impl {
   /// The participant that announces the scene is the server: swarm samples
   /// are taken from it alone. A restarted server announces itself again. mu held.
   void on_scene(const msg::Scene& s, const eprosima::fastrtps::rtps::GuidPrefix_t& from) {
+    // Every server participant has its own instance (a re-joined server is a
+    // new one), so this instance from another participant is a copy (a
+    // replay, a relay): refused, or its sender would become "the server".
+    if (scene && s.server_instance() == server_instance && from != server) {
+      ++rejected;
+      if (!std::exchange(copy_logged, true))
+        spdlog::warn(
+            "{}: refused a copy of the server's scene (instance {:016x}) from another "
+            "participant; staying with the server that announced it",
+            label, s.server_instance());
+      return;
+    }
     server = from;
     const int highest = cfg.drone_ids.empty() ? 0 : *std::max_element(cfg.drone_ids.begin(), cfg.drone_ids.end());
     if (s.num_drones() <= highest) {
