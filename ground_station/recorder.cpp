@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <span>
 #include <string>
@@ -258,6 +259,14 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
   if (!(rate > 0)) throw std::invalid_argument("--rate must be > 0");
   mcap::Reader r(path);
   Participant dds(dds_cfg, "ddswarm-replay");
+  // A live server on this domain would take the recording's missions and
+  // commands as its own, and its agents the recorded scene: refuse.
+  std::mutex mu;
+  std::optional<std::uint64_t> live_server;
+  auto& scenes = dds.reader<msg::Scene>([&](const msg::Scene& s, const fdds::SampleInfo&) {
+    std::lock_guard<std::mutex> lock(mu);
+    live_server = s.server_instance();
+  });
   // One publisher per recorded channel whose topic ddswarm knows.
   std::map<std::uint16_t, std::function<void(std::span<const std::uint8_t>)>> publish;
   for (const auto& [id, ch] : r.channels()) {
@@ -275,8 +284,15 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
       };
     });
   }
-  // Let readers match before the first sample (volatile samples sent earlier are lost).
+  // Let readers match before the first sample (volatile samples sent earlier
+  // are lost), and a live server's scene (transient local) arrive.
   wait_for_stop(std::chrono::milliseconds(1500));
+  dds.remove(scenes);
+  if (live_server)
+    throw std::runtime_error(
+        fmt::format("a live server (instance {:016x}) is on DDS domain {}: its swarm would fly the "
+                    "recording's missions and commands; replay on another domain (--domain)",
+                    *live_server, dds_cfg.domain_id));
   std::uint64_t sent = 0;
   do {
     const auto start = std::chrono::steady_clock::now();

@@ -58,6 +58,7 @@ std::string describe_recording(const std::string& path, bool messages = false);
 
 /// Republishes a recording with its original timing scaled by rate (> 0);
 /// loops when asked, until stop_requested(). Returns messages published.
+/// Throws, before publishing anything, when a live server's scene is on the domain.
 std::uint64_t replay(const DdsConfig& dds, const std::string& path, double rate, bool loop,
                      const std::vector<std::string>& topics);
 

@@ -2,7 +2,8 @@
 # Issue 6: the recorder writes every sample it receives to an MCAP file that
 # an independent reader (npm @mcap/core) reads back exactly; SIGINT finalizes;
 # after SIGKILL the file still reads up to its last chunk; a full disk is a
-# clear error; replay reproduces the same sample sequence.
+# clear error; replay reproduces the same sample sequence, and refuses a
+# domain where a server is live.
 source "$(dirname "$0")/lib.sh"
 reader="$SRC/tests/mcap_independent_reader.mjs"
 node_ok=1
@@ -86,4 +87,14 @@ sleep 2.5
 out=$(timeout 30 "$BIN/ddswarm-gs" --domain "$DOMAIN" status 2>&1) || fail "status on a replay failed: $out"
 echo "status on the replay: $out"
 echo "$out" | grep -q "3/3 online\|drones [0-9]/3" || fail "status does not show the replayed swarm: $out"
+kill -TERM "$PID_replay"; wait_pid "$PID_replay" 10 || fail "replay did not stop"
+# 6. A replay onto a domain with a live server publishes nothing: the
+#    server's swarm would fly the recorded missions.
+start sim2 "$BIN/ddswarm-sim" --scenario "$SRC/config/thesis_course.yaml" --drones 3 --domain "$DOMAIN"
+timeout 30 "$BIN/ddswarm-gs" --domain "$DOMAIN" status >/dev/null 2>&1 || fail "no live server"
+out=$(timeout 30 "$BIN/ddswarm-replay" "$run" --domain "$DOMAIN" 2>&1); rc=$?
+echo "replay beside a live server: rc $rc: $out"
+[ $rc -ne 0 ] && [ $rc -ne 124 ] || fail "a replay onto a live server's domain ran (rc $rc)"
+echo "$out" | grep -q "live server.*domain $DOMAIN.*--domain" || fail "the refusal does not say why: $out"
+echo "$out" | grep -q "messages published" && fail "the refused replay published: $out"
 echo PASS
