@@ -123,6 +123,10 @@ TEST(Experiment, ARunWhoseSwarmNeverCameUpStartsAgain) {
       gs, 6, TaskConfig{}, nullptr, [] { return true; }, 0.3);
   EXPECT_FALSE(died.never_up);
   EXPECT_FALSE(start_run_again(died, false, 1));
+  // The experiment runner, which has already waited, asks for the same outcome.
+  const TaskOutcome waited = swarm_not_up(gs, 6, 30.0);
+  EXPECT_TRUE(waited.never_up);
+  EXPECT_EQ(waited.reason, "only 0/6 agents online (0 heard by the server) after 30 s");
   TaskOutcome refused;
   refused.reason = "task: refused";
   EXPECT_FALSE(start_run_again(refused, false, 1));

@@ -22,22 +22,27 @@ namespace ddswarm::gs {
 
 namespace fs = std::filesystem;
 
+TaskOutcome swarm_not_up(DdsCommander& gs, int drones, double waited_s,
+                         const std::function<bool()>& give_up) {
+  TaskOutcome fail;
+  if (give_up && give_up()) {
+    fail.reason = "a process of the run ended before the swarm was up";
+    return fail;
+  }
+  auto st = gs.status();
+  fail.reason =
+      fmt::format("only {}/{} agents online ({} heard by the server) after {:g} s",
+                  st.drones_online, drones, std::max(st.drones_server_hears, 0), waited_s);
+  fail.never_up = true;
+  return fail;
+}
+
 TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
                      const std::function<void(const std::string&)>& progress,
                      const std::function<bool()>& give_up, double swarm_wait_s) {
+  if (!gs.wait_for_swarm(drones, swarm_wait_s, give_up))
+    return swarm_not_up(gs, drones, swarm_wait_s, give_up);
   TaskOutcome fail;
-  if (!gs.wait_for_swarm(drones, swarm_wait_s, give_up)) {
-    if (give_up && give_up()) {
-      fail.reason = "a process of the run ended before the swarm was up";
-      return fail;
-    }
-    auto st = gs.status();
-    fail.reason =
-        fmt::format("only {}/{} agents online ({} heard by the server) after {:g} s",
-                    st.drones_online, drones, std::max(st.drones_server_hears, 0), swarm_wait_s);
-    fail.never_up = true;
-    return fail;
-  }
   auto r = gs.takeoff(0);
   if (progress) progress(r.message);
   if (!r.ok) {
@@ -240,8 +245,8 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       const auto shares = agent_host_shares(ids, opt.agent_hosts);
       for (std::size_t h = 0; h < shares.size(); ++h)
         procs.start({"agent host " + std::to_string(h),
-                     common_args({bin + "/ddswarm-agent", "--ids", shares[h], "--config", p.scenario_file,
-                                  "--duplicate-probe", "0.2"})});
+                     common_args({bin + "/ddswarm-agent", "--ids", shares[h], "--config",
+                                  p.scenario_file, "--duplicate-probe", "0.2"})});
       for (int i = 0; opt.agent_hosts == 0 && i < rec.drones; ++i)
         procs.start({"agent " + std::to_string(i),
                      common_args({bin + "/ddswarm-agent", "--id", std::to_string(i), "--config",
@@ -265,10 +270,13 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
         }
       });
       const auto give_up = [&] { return someone_died.load(); };
-      gs.wait_for_swarm(rec.drones, 30.0, give_up);  // fly_task says so if it failed
+      // Waited for here, to split start-up from flight; a swarm not up is
+      // not waited for again.
+      const bool up = gs.wait_for_swarm(rec.drones, kSwarmWaitS, give_up);
       const double flight_start = wall_seconds();
       times.startup_s = flight_start - run_start;
-      o = fly_task(gs, rec.drones, p.task, nullptr, give_up);
+      o = up ? fly_task(gs, rec.drones, p.task, nullptr, give_up)
+             : swarm_not_up(gs, rec.drones, kSwarmWaitS, give_up);
       times.flight_s = wall_seconds() - flight_start;
       finished = true;
       watchdog.join();

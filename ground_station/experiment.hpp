@@ -17,9 +17,18 @@ namespace ddswarm::gs {
 /// give_up (optional) ends the wait for the swarm at once, e.g. when a
 /// process of the run has died. A swarm not up within swarm_wait_s fails
 /// with never_up set.
+/// How long an experiment run and fly_task wait for the swarm to come up (s).
+inline constexpr double kSwarmWaitS = 30.0;
+
 TaskOutcome fly_task(DdsCommander& gs, int drones, const TaskConfig& task,
                      const std::function<void(const std::string&)>& progress,
-                     const std::function<bool()>& give_up = {}, double swarm_wait_s = 30.0);
+                     const std::function<bool()>& give_up = {}, double swarm_wait_s = kSwarmWaitS);
+
+/// The outcome of a swarm that was waited for waited_s and is not up: never_up
+/// set, and a reason naming how many agents are online and heard by the
+/// server; or, when give_up() says a process of the run ended, that instead.
+TaskOutcome swarm_not_up(DdsCommander& gs, int drones, double waited_s,
+                         const std::function<bool()>& give_up = {});
 
 /// Times an experiment starts a run whose swarm never came up, before it
 /// records the run as failed.
