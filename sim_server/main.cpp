@@ -56,10 +56,21 @@ int main(int argc, char** argv) {
                    r.files_removed, r.bytes_freed / 1e6);
     ddswarm::install_rejoin_signal();
     // A new server each time SIGUSR1 asks before a mission (SimServer::run).
+    std::uint64_t rival = 0;
     ddswarm::keep_joining(duration_s, [&](double left) {
       ddswarm::sim::SimServer server(cfg);
-      return server.run(left) == ddswarm::sim::SimServer::End::kRejoinRequested;
+      const auto end = server.run(left);
+      rival = server.rival_instance();
+      return end == ddswarm::sim::SimServer::End::kRejoinRequested;
     });
+    if (rival != 0) {
+      std::fprintf(
+          stderr,
+          "ddswarm-sim: error: another server (instance %016llx) is already on DDS domain %d: "
+          "two swarms on one domain would be one; use another --domain\n",
+          static_cast<unsigned long long>(rival), cfg.dds.domain_id);
+      return 3;
+    }
     return 0;
   });
 }

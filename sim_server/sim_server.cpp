@@ -126,6 +126,11 @@ struct SimServer::Impl {
   std::vector<msg::Beacon> pending_beacons;  // carried by accepted commands, forwarded next tick
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
   bool rejoin = false;  // run() ended on a rejoin request (rejoin_now)
+  // Another server's scene on this domain (on_rival_scene): its instance, when
+  // this one is the newcomer and leaves; whether the log said so, when it stays.
+  std::uint64_t rival_instance = 0;
+  bool rival_logged = false;
+  std::int64_t scene_published_ns = 0;  // system clock, as the scene's source timestamp
   bool swarm_silent = false;  // expire_agents: no live agent heard within agent_timeout_s
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
@@ -246,7 +251,31 @@ struct SimServer::Impl {
         [this](const msg::AgentStatus& s, const fdds::SampleInfo&) { on_heartbeat(s); });
     dds.reader<msg::MissionCommand>(
         [this](const msg::MissionCommand& m, const fdds::SampleInfo&) { on_mission(m); });
+    dds.reader<msg::Scene>([this](const msg::Scene& s, const fdds::SampleInfo& info) {
+      if (s.server_instance() != instance)
+        on_rival_scene(s.server_instance(), info.source_timestamp.to_ns());
+    });
     publish_scene();
+  }
+
+  /// Two servers on one domain would fly one swarm in two worlds: the agents
+  /// follow whichever scene they heard first. Each server publishes its scene
+  /// once, as it joins; the one whose scene is the newer is the newcomer and
+  /// leaves (run() ends kRivalServer), even if the other swarm's agents
+  /// already answer it. The other says so once and stays.
+  void on_rival_scene(std::uint64_t other, std::int64_t other_published_ns) {
+    std::lock_guard<std::mutex> lock(mu);
+    const std::int64_t own = scene_published_ns != 0 ? scene_published_ns : system_now_ns();
+    if (other_published_ns < own) {
+      rival_instance = other;
+      cv.notify_all();
+      return;
+    }
+    if (!std::exchange(rival_logged, true))
+      spdlog::error(
+          "another server (instance {:016x}) is on DDS domain {}: two swarms on one domain "
+          "are one swarm; it should leave (this one stays: it came first)",
+          other, cfg.dds.domain_id);
   }
 
   // ---- DDS callbacks (Fast DDS threads) ----
@@ -559,6 +588,10 @@ struct SimServer::Impl {
     s.arm_length_m(cfg.quadrotor.arm_length_m);
     s.sensor_count(static_cast<std::uint16_t>(cfg.sensors.count));
     s.sensor_max_range_m(static_cast<float>(cfg.sensors.max_range_m));
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      scene_published_ns = system_now_ns();
+    }
     w_scene.write(s);
   }
 
@@ -782,10 +815,22 @@ struct SimServer::Impl {
     publish_next();
   }
 
+  static std::int64_t system_now_ns() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::system_clock::now().time_since_epoch())
+        .count();
+  }
+
+  bool rival() {
+    std::lock_guard<std::mutex> lock(mu);
+    return rival_instance != 0;
+  }
+
   /// SIGUSR1 (ddswarm-launch: its discovery server dropped this participant's
   /// endpoints, so no agent will ever match them): leave DDS and start again
   /// as a new server, but only before any mission command came.
   bool rejoin_now() {
+    if (rival()) return true;
     if (!take_rejoin_request()) return false;
     std::lock_guard<std::mutex> lock(mu);
     if (!seen_missions.empty()) {
@@ -916,6 +961,7 @@ struct SimServer::Impl {
     state_text = "stopping";
     publish_status(true);
     spdlog::info("ddswarm-sim: stopped at tick {} (sim {:.2f} s)", tick, sim_time());
+    if (rival()) return SimServer::End::kRivalServer;
     return rejoin ? SimServer::End::kRejoinRequested : SimServer::End::kStopped;
   }
 };
@@ -923,5 +969,9 @@ struct SimServer::Impl {
 SimServer::SimServer(ServerConfig cfg) : impl_(std::make_unique<Impl>(std::move(cfg))) {}
 SimServer::~SimServer() = default;
 SimServer::End SimServer::run(double duration_s) { return impl_->run(duration_s); }
+std::uint64_t SimServer::rival_instance() const {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->rival_instance;
+}
 
 }  // namespace ddswarm::sim

@@ -34,12 +34,16 @@ class SimServer {
   /// Builds the world and joins DDS; throws on failure (message names what failed).
   explicit SimServer(ServerConfig cfg);
   ~SimServer();
-  enum class End { kStopped, kRejoinRequested };
+  enum class End { kStopped, kRejoinRequested, kRivalServer };
   /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
   /// kStopped. kRejoinRequested on take_rejoin_request() (SIGUSR1) before any
   /// mission command came: the caller should destroy this server and start a
   /// new one (a new world, which before a mission loses nothing).
+  /// kRivalServer when another server was already on the domain as this one
+  /// joined (rival_instance() names it): the caller should exit.
   End run(double duration_s);
+  /// The other server's instance after kRivalServer, else 0.
+  std::uint64_t rival_instance() const;
 
  private:
   struct Impl;

@@ -5,7 +5,7 @@ add_executable(hostile_publisher hostile_publisher.cpp)
 target_link_libraries(hostile_publisher PRIVATE ddswarm_common)
 
 ddswarm_process_test(mp_hostile_samples 60 hostile_samples_test.sh)
-ddswarm_process_test(mp_duplicate_agent 40 duplicate_agent_test.sh)
+ddswarm_process_test(mp_duplicate_agent 90 duplicate_agent_test.sh)
 ddswarm_process_test(mp_config_errors 60 config_errors_test.sh)
 ddswarm_process_test(mp_network_safety 60 network_safety_test.sh)
 set_tests_properties(mp_network_safety PROPERTIES SKIP_RETURN_CODE 77)
