@@ -197,13 +197,16 @@ struct AgentApp::Impl {
       brains.push_back(std::make_unique<DroneBrain>(id));
       by_id[id] = brains.back().get();
     }
-    auto& probe = dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& s, const fdds::SampleInfo&) {
-      std::lock_guard<std::mutex> lock(mu);
-      auto it = by_id.find(s.drone_id());
-      if (it == by_id.end() || s.agent_instance() == it->second->instance) return;
-      it->second->rival = s.agent_instance();
-      it->second->rival_where = s.host().to_string() + " pid " + std::to_string(s.pid());
-    });
+    Reader<msg::AgentStatus>* probe = nullptr;
+    if (cfg.duplicate_probe_s > 0)
+      probe =
+          &dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& s, const fdds::SampleInfo&) {
+            std::lock_guard<std::mutex> lock(mu);
+            auto it = by_id.find(s.drone_id());
+            if (it == by_id.end() || s.agent_instance() == it->second->instance) return;
+            it->second->rival = s.agent_instance();
+            it->second->rival_where = s.host().to_string() + " pid " + std::to_string(s.pid());
+          });
     scenes = &dds.reader<msg::Scene>([this](const msg::Scene& s, const fdds::SampleInfo& info) {
       std::lock_guard<std::mutex> lock(mu);
       on_scene(s, info.sample_identity.writer_guid().guidPrefix);
@@ -220,7 +223,7 @@ struct AgentApp::Impl {
     // Every agent hearing every other's heartbeat is O(N^2) traffic: at 64
     // agents it cost 1.7 cores of a paused swarm. After the probe, a rival is
     // the server's business (it keeps the first owner and counts impostors).
-    dds.remove(probe);
+    if (probe) dds.remove(*probe);
     publish_status();
   }
 

@@ -75,7 +75,8 @@ struct AgentConfig {
   double goal_gain = 0.3;         ///< 1/s, task gathering: pull toward the goal point, (0, 5]
   double teleop_timeout_s = 1.0;   ///< s (sim), leader's teleop velocity drops to 0 after this; > 0
   double server_timeout_s = 1.0;   ///< s (wall): no server sample this long = server lost (logged once, flagged in heartbeats); > 0
-  double rejoin_after_s = 20.0;    ///< s (wall): no scene this long after joining: leave DDS and join again as a new participant (0 = never)
+  double rejoin_after_s = 40.0;  ///< s (wall): no scene this long after joining: leave DDS and join
+                                 ///< again as a new participant (0 = never)
   /// Fault injection: the share of the server's swarm-state samples this
   /// agent drops on arrival, as if lost on the way; [0, 0.5]. Real time flies
   /// on the next sample; lockstep waits sim.lockstep_resend_s for the tick again.

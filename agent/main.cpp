@@ -79,9 +79,16 @@ int main(int argc, char** argv) {
       using ddswarm::agent::AgentApp;
       // A new participant each time no scene came (agent.rejoin_after_s), SIGUSR1 asked for one,
       // or this process outlived its DDS lease (stopped or starved).
+      // Each join that heard no scene waits twice as long as the one before
+      // (rejoin_patience_s): a swarm whose discovery is slow still comes up.
+      int no_scene = 0;
+      const double rejoin_after_s = cfg.agent.rejoin_after_s;
       ddswarm::keep_joining(duration_s, [&](double left) {
+        cfg.agent.rejoin_after_s = ddswarm::rejoin_patience_s(rejoin_after_s, no_scene);
         AgentApp agent(cfg);
-        return agent.run(left) != AgentApp::End::kStopped;
+        const auto end = agent.run(left);
+        no_scene = end == AgentApp::End::kNoScene ? no_scene + 1 : 0;
+        return end != AgentApp::End::kStopped;
       });
     } catch (const ddswarm::agent::DuplicateAgent& e) {
       std::fprintf(stderr, "ddswarm-agent: error: %s\n", e.what());

@@ -70,6 +70,10 @@ void unblock_signals_for_exec() {
 
 bool take_rejoin_request() { return g_rejoin.exchange(false); }
 
+double rejoin_patience_s(double base_s, int attempt) {
+  return base_s * static_cast<double>(1 << std::clamp(attempt, 0, 3));
+}
+
 void keep_joining(double duration_s, const std::function<bool(double left_s)>& join) {
   const double end = duration_s > 0 ? wall_seconds() + duration_s : 0;
   while (!stop_requested()) {

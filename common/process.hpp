@@ -35,6 +35,13 @@ bool take_rejoin_request();
 /// returns false, a stop is requested or duration_s (> 0) has passed.
 void keep_joining(double duration_s, const std::function<bool(double left_s)>& join);
 
+/// How long a participant that heard nothing waits before joining again, at
+/// its attempt-th try (0 first): base_s, doubled at each try, at most 8 times
+/// base_s. Discovery that is slow because a swarm is coming up must not be
+/// restarted at a fixed pace: every new participant is more discovery work,
+/// and at 128 processes fixed re-joins kept the swarm from ever coming up.
+double rejoin_patience_s(double base_s, int attempt);
+
 /// Notices that this process was stopped (SIGSTOP, Ctrl-Z, a debugger) or
 /// starved for longer than the DDS lease it announces. Its peers may then
 /// have dropped it while it still holds them, and Fast DDS 2.9 does not

@@ -21,5 +21,14 @@ TEST(LeaseWatch, RestartLeavesOwnWorkOutOfTheGap) {
   EXPECT_EQ(w.turn(10.5), "");
 }
 
+TEST(RejoinPatience, DoublesAtEachTryUpToEightTimes) {
+  EXPECT_EQ(rejoin_patience_s(20.0, 0), 20.0);
+  EXPECT_EQ(rejoin_patience_s(20.0, 1), 40.0);
+  EXPECT_EQ(rejoin_patience_s(20.0, 2), 80.0);
+  EXPECT_EQ(rejoin_patience_s(20.0, 3), 160.0);
+  EXPECT_EQ(rejoin_patience_s(20.0, 30), 160.0);  // no overflow, no endless growth
+  EXPECT_EQ(rejoin_patience_s(10.0, -1), 10.0);
+}
+
 }  // namespace
 }  // namespace ddswarm

@@ -246,11 +246,11 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       for (std::size_t h = 0; h < shares.size(); ++h)
         procs.start({"agent host " + std::to_string(h),
                      common_args({bin + "/ddswarm-agent", "--ids", shares[h], "--config",
-                                  p.scenario_file, "--duplicate-probe", "0.2"})});
+                                  p.scenario_file, "--duplicate-probe", "0"})});
       for (int i = 0; opt.agent_hosts == 0 && i < rec.drones; ++i)
         procs.start({"agent " + std::to_string(i),
                      common_args({bin + "/ddswarm-agent", "--id", std::to_string(i), "--config",
-                                  p.scenario_file, "--duplicate-probe", "0.2"})});
+                                  p.scenario_file, "--duplicate-probe", "0"})});
       DdsConfig dds = opt.dds;
       dds.domain_id = domain;
       DdsCommander gs(opt.gs, dds);

@@ -239,18 +239,27 @@ int main(int argc, char** argv) {
                                                    agent_participant_id(n, ids.back()), lo, hi);
       if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
     }
+    // Started with the server, the whole swarm has one agent per id, so the
+    // agents skip their duplicate probe: N probe readers each matching N
+    // status writers kept a 128-process swarm from coming up at all
+    // (docs/performance.md, "Bringing up 128 processes"). Agents launched
+    // apart from their server (--ids, --only) keep it.
+    const bool whole_swarm = only == "all" && ids_text.empty();
+    const auto agent_args = [&](std::vector<std::string> a) {
+      if (whole_swarm) a.insert(a.end(), {"--duplicate-probe", "0"});
+      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      return a;
+    };
     // Agent hosts: K processes, each flying a contiguous share of the ids.
     const auto shares = agent_host_shares(ids, agent_hosts);
     for (std::size_t h = 0; h < shares.size(); ++h) {
-      std::vector<std::string> a = {bin + "/ddswarm-agent", "--ids", shares[h], "--config", scenario, "--drones",
-                                    std::to_string(n)};
-      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      const auto a = agent_args({bin + "/ddswarm-agent", "--ids", shares[h], "--config", scenario,
+                                 "--drones", std::to_string(n)});
       procs.start({"agent host " + std::to_string(h), a});
     }
     for (int id : agent_hosts > 0 ? std::vector<int>{} : ids) {
-      std::vector<std::string> a = {bin + "/ddswarm-agent", "--id", std::to_string(id), "--config",
-                                    scenario, "--drones", std::to_string(n)};
-      a.insert(a.end(), dds_args.begin(), dds_args.end());
+      auto a = agent_args({bin + "/ddswarm-agent", "--id", std::to_string(id), "--config", scenario,
+                           "--drones", std::to_string(n)});
       if (const int pid = agent_participant_id(n, id); pid >= 0) {
         a.push_back("--participant-id");
         a.push_back(std::to_string(pid));

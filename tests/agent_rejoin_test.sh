@@ -8,7 +8,8 @@ scenario="$WORK/rejoin.yaml"
 sed 's/^agent:$/agent:\n  rejoin_after_s: 2.0/' "$SRC/config/thesis_course.yaml" >"$scenario"
 grep -q "rejoin_after_s: 2.0" "$scenario" || fail "could not write the test scenario"
 start agent "$BIN/ddswarm-agent" --id 0 --config "$scenario" --domain "$DOMAIN"
-# No server: it re-joins every ~3 s (2 s without a scene + its 1 s duplicate probe).
+# No server: it re-joins after ~3 s (2 s without a scene + its 1 s duplicate
+# probe), then after twice as long (rejoin_patience_s).
 for _ in $(seq "$(slow 150)"); do [ "$(grep -c "joining again" "$WORK/agent.log")" -ge 2 ] && break; sleep 0.1; done
 [ "$(grep -c "joining again" "$WORK/agent.log")" -ge 2 ] || fail "the agent did not re-join twice without a server"
 instances=$(sed -n 's/.*agent \([0-9a-f]*\) flying.*/\1/p' "$WORK/agent.log" | sort -u | wc -l)
@@ -49,8 +50,8 @@ grep -q "a mission has begun: staying" "$WORK/sim.log" || fail "the server did n
 [ "$(grep -c "starting again as a new server" "$WORK/sim.log")" -eq 1 ] || fail "the server started again mid-mission"
 
 # A ground station that hears no server through a discovery server within
-# 10 s joins again as a new participant, and keeps trying until its
-# discovery timeout (the discovery server may have dropped its endpoints).
+# 20 s joins again as a new participant, and keeps trying (40 s, ...) until
+# its discovery timeout (the discovery server may have dropped its endpoints).
 ds_scenario="$WORK/rejoin_ds.yaml"
 sed 's/^ground_station:$/ground_station:\n  discovery_timeout_s: 40.0/' "$scenario" >"$ds_scenario"
 grep -q "discovery_timeout_s: 40.0" "$ds_scenario" || fail "could not write the discovery-server scenario"
@@ -59,8 +60,8 @@ port=$(( 20000 + RANDOM % 20000 ))
 start ds fast-discovery-server -i 0 -l 127.0.0.1 -p "$port" -x "$SRC/config/discovery_server.xml"
 start gs_early timeout 60 "$BIN/ddswarm-gs" --config "$ds_scenario" --domain "$ds_domain" \
   --discovery-server "127.0.0.1:$port" wait-agents --count 1 --timeout 30
-for _ in $(seq "$(slow 150)"); do grep -q "joining again as a new participant" "$WORK/gs_early.log" && break; sleep 0.1; done
-grep -q "joining again as a new participant" "$WORK/gs_early.log" || fail "the ground station did not join again after 10 s without a server"
+for _ in $(seq "$(slow 250)"); do grep -q "joining again as a new participant" "$WORK/gs_early.log" && break; sleep 0.1; done
+grep -q "joining again as a new participant" "$WORK/gs_early.log" || fail "the ground station did not join again after 20 s without a server"
 start sim_ds "$BIN/ddswarm-sim" --scenario "$ds_scenario" --domain "$ds_domain" --discovery-server "127.0.0.1:$port"
 start agent_ds "$BIN/ddswarm-agent" --id 0 --config "$ds_scenario" --domain "$ds_domain" --discovery-server "127.0.0.1:$port"
 wait_pid "$PID_gs_early" 60; rc=$?
