@@ -280,9 +280,9 @@ int main(int argc, char** argv) {
     // Status needs only the clock (a replayed recording has no server to command).
     // Through a discovery server, a participant that hears no server within
     // kRejoinAfterS (then twice as long at each try) joins again as a new
-    // one: under a 128-process bring-up
-    // Fast DDS 2.9's discovery server sometimes drops a participant's endpoints
-    // for good, and a ground station's as well as an agent's.
+    // one: under a 128-process bring-up Fast DDS 2.9's discovery server
+    // sometimes drops a participant's endpoints for good, and a ground
+    // station's as well as an agent's.
     std::unique_ptr<DdsCommander> commander;
     const bool via_discovery_server = file.dds.discovery == Discovery::kDiscoveryServer;
     bool ready = false;
