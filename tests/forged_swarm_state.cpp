@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
     });
     const auto heard = [&] {
       std::lock_guard<std::mutex> lock(mu);
-      return have_status;
+      return have_status && (!copy_scene || real_scene);  // the scene may come after a heartbeat
     };
     for (int i = 0; i < 50 && !heard(); ++i) wait_for_stop(std::chrono::milliseconds(100));
     {
