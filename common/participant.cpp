@@ -8,6 +8,10 @@
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <bit>
 #include <filesystem>
 #include <mutex>
 #include <optional>
@@ -174,7 +178,21 @@ ProcessParticipants& process_participants() {
   return p;
 }
 
+std::atomic<std::uint64_t> g_write_throws{0};
+
 }  // namespace
+
+bool write_threw(fdds::DataWriter* w, const std::exception& e) {
+  const std::uint64_t n = ++g_write_throws;
+  if (std::has_single_bit(n)) {
+    const fdds::Topic* t = w ? w->get_topic() : nullptr;
+    spdlog::warn("a DDS write on {} threw ({} so far in this process), its sample lost; carrying on: {}",
+                 t ? t->get_name() : std::string("an unknown topic"), n, e.what());
+  }
+  return false;
+}
+
+std::uint64_t write_throws() { return g_write_throws.load(); }
 
 eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
                                                           std::uint32_t n) {

@@ -4,6 +4,7 @@
 // The participant's transports come from DdsConfig (localhost-only unless the
 // user opts in); QoS comes from the XML profiles named in common/topics.hpp.
 #include <atomic>
+#include <cstdint>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
@@ -35,12 +36,28 @@ class DdsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Records a write that Fast DDS threw out of, and returns false. Fast DDS
+/// 2.9 throws through DataWriter::write when a shared-memory lock of a
+/// reader's stays held past its timeout ("Interprocess mutex timeout when
+/// locking. Possible deadlock: owner died without unlocking?"): a process
+/// SIGKILLed while it held it. The sample is lost for that reader; the writer
+/// goes on. Logged at the first failure and at every power of two after it.
+bool write_threw(fdds::DataWriter* w, const std::exception& e);
+/// How many writes have thrown in this process (write_threw).
+std::uint64_t write_throws();
+
 template <class T>
 class Writer {
  public:
   explicit Writer(fdds::DataWriter* w) : w_(w) {}
-  /// Returns false when DDS refused the sample.
-  bool write(const T& sample) { return w_->write(const_cast<T*>(&sample)); }
+  /// Returns false when DDS refused the sample or threw (write_threw).
+  bool write(const T& sample) {
+    try {
+      return w_->write(const_cast<T*>(&sample));
+    } catch (const std::exception& e) {
+      return write_threw(w_, e);
+    }
+  }
   /// Number of matched readers.
   int matched() const {
     fdds::PublicationMatchedStatus s;

@@ -11,6 +11,9 @@
 #include <string>
 #include <thread>
 
+#include <fastdds/dds/topic/TopicDataType.hpp>
+#include <stdexcept>
+
 #include "common/participant.hpp"
 #include "common/process.hpp"
 
@@ -232,6 +235,56 @@ TEST(Participant, WithoutTheShmTransportTheSwarmStateStillComesByDataSharing) {
   cfg.shm_transport = true;
   Participant with(cfg, "participant_test");
   EXPECT_EQ(std::filesystem::exists(port), with.shared_memory()) << port;
+}
+
+// A type whose serialization throws what Fast DDS 2.9 throws out of
+// DataWriter::write when a reader's shared-memory lock stays held (its
+// process SIGKILLed while holding it): the same path through the writer.
+class ThrowingType : public fdds::TopicDataType {
+ public:
+  ThrowingType() {
+    setName("ddswarm_test::Throwing");
+    m_typeSize = 16;
+    m_isGetKeyDefined = false;
+  }
+  bool serialize(void*, eprosima::fastrtps::rtps::SerializedPayload_t*) override { return false; }
+  bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t*, void*) override { return false; }
+  // Before the writer takes a payload from its pool (a throw from serialize
+  // would leak one, and Fast DDS asserts on that when the writer is deleted).
+  std::function<uint32_t()> getSerializedSizeProvider(void*) override {
+    return []() -> uint32_t {
+      throw std::runtime_error("Interprocess mutex timeout when locking. Possible deadlock: owner died");
+    };
+  }
+  void* createData() override { return new int(0); }
+  void deleteData(void* d) override { delete static_cast<int*>(d); }
+  bool getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t*, bool) override { return false; }
+};
+
+// A server whose write throws must not die of it: the write returns false,
+// is counted, and the next write is tried again (issue 9's killed agent,
+// docs/faults.md).
+TEST(Participant, AWriteThatThrowsIsCountedAndTheWriterGoesOn) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant p(cfg, "participant_test");
+  fdds::TypeSupport ts(new ThrowingType());
+  ASSERT_EQ(ts.register_type(p.raw()), ReturnCode_t::RETCODE_OK);
+  auto* topic = p.raw()->create_topic("ddswarm_test/throwing", ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+  ASSERT_NE(topic, nullptr);
+  auto* pub = p.raw()->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+  ASSERT_NE(pub, nullptr);
+  auto* raw = pub->create_datawriter(topic, fdds::DATAWRITER_QOS_DEFAULT);
+  ASSERT_NE(raw, nullptr);
+  Writer<int> w(raw);
+  const std::uint64_t before = write_throws();
+  int sample = 7;
+  EXPECT_FALSE(w.write(sample));
+  EXPECT_FALSE(w.write(sample));
+  EXPECT_EQ(write_throws(), before + 2);
+  pub->delete_datawriter(raw);
+  p.raw()->delete_publisher(pub);
+  p.raw()->delete_topic(topic);
 }
 
 }  // namespace
