@@ -186,8 +186,9 @@ bool write_threw(fdds::DataWriter* w, const std::exception& e) {
   const std::uint64_t n = ++g_write_throws;
   if (std::has_single_bit(n)) {
     const fdds::Topic* t = w ? w->get_topic() : nullptr;
-    spdlog::warn("a DDS write on {} threw ({} so far in this process), its sample lost; carrying on: {}",
-                 t ? t->get_name() : std::string("an unknown topic"), n, e.what());
+    spdlog::warn(
+        "a DDS write on {} threw ({} so far in this process), its sample lost; carrying on: {}",
+        t ? t->get_name() : std::string("an unknown topic"), n, e.what());
   }
   return false;
 }

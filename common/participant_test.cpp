@@ -253,7 +253,8 @@ class ThrowingType : public fdds::TopicDataType {
   // would leak one, and Fast DDS asserts on that when the writer is deleted).
   std::function<uint32_t()> getSerializedSizeProvider(void*) override {
     return []() -> uint32_t {
-      throw std::runtime_error("Interprocess mutex timeout when locking. Possible deadlock: owner died");
+      throw std::runtime_error(
+          "Interprocess mutex timeout when locking. Possible deadlock: owner died");
     };
   }
   void* createData() override { return new int(0); }
@@ -270,7 +271,8 @@ TEST(Participant, AWriteThatThrowsIsCountedAndTheWriterGoesOn) {
   Participant p(cfg, "participant_test");
   fdds::TypeSupport ts(new ThrowingType());
   ASSERT_EQ(ts.register_type(p.raw()), ReturnCode_t::RETCODE_OK);
-  auto* topic = p.raw()->create_topic("ddswarm_test/throwing", ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+  auto* topic =
+      p.raw()->create_topic("ddswarm_test/throwing", ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
   ASSERT_NE(topic, nullptr);
   auto* pub = p.raw()->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
   ASSERT_NE(pub, nullptr);
