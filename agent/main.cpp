@@ -82,10 +82,10 @@ int main(int argc, char** argv) {
       // Each join that heard no scene waits twice as long as the one before
       // (rejoin_patience_s): a swarm whose discovery is slow still comes up.
       int no_scene = 0;
-      const double rejoin_after_s = cfg.agent.rejoin_after_s;
       ddswarm::keep_joining(duration_s, [&](double left) {
-        cfg.agent.rejoin_after_s = ddswarm::rejoin_patience_s(rejoin_after_s, no_scene);
-        AgentApp agent(cfg);
+        auto join = cfg;  // the user's configuration stays as given
+        join.agent.rejoin_after_s = ddswarm::rejoin_patience_s(cfg.agent.rejoin_after_s, no_scene);
+        AgentApp agent(join);
         const auto end = agent.run(left);
         no_scene = end == AgentApp::End::kNoScene ? no_scene + 1 : 0;
         return end != AgentApp::End::kStopped;

@@ -245,12 +245,11 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       const auto shares = agent_host_shares(ids, opt.agent_hosts);
       for (std::size_t h = 0; h < shares.size(); ++h)
         procs.start({"agent host " + std::to_string(h),
-                     common_args({bin + "/ddswarm-agent", "--ids", shares[h], "--config",
-                                  p.scenario_file, "--duplicate-probe", "0"})});
+                     common_args(agent_command(bin, shares[h], true, p.scenario_file, true))});
       for (int i = 0; opt.agent_hosts == 0 && i < rec.drones; ++i)
         procs.start({"agent " + std::to_string(i),
-                     common_args({bin + "/ddswarm-agent", "--id", std::to_string(i), "--config",
-                                  p.scenario_file, "--duplicate-probe", "0"})});
+                     common_args(agent_command(bin, std::to_string(i), false, p.scenario_file,
+                                               true))});
       DdsConfig dds = opt.dds;
       dds.domain_id = domain;
       DdsCommander gs(opt.gs, dds);

@@ -239,27 +239,21 @@ int main(int argc, char** argv) {
                                                    agent_participant_id(n, ids.back()), lo, hi);
       if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
     }
-    // Started with the server, the whole swarm has one agent per id, so the
-    // agents skip their duplicate probe: N probe readers each matching N
-    // status writers kept a 128-process swarm from coming up at all
-    // (docs/performance.md, "Bringing up 128 processes"). Agents launched
-    // apart from their server (--ids, --only) keep it.
+    // The whole swarm with its server (not --ids, --only): agent_command's
+    // agents skip their duplicate probe.
     const bool whole_swarm = only == "all" && ids_text.empty();
-    const auto agent_args = [&](std::vector<std::string> a) {
-      if (whole_swarm) a.insert(a.end(), {"--duplicate-probe", "0"});
+    const auto agent_args = [&](const std::string& agent_ids, bool host) {
+      auto a = agent_command(bin, agent_ids, host, scenario, whole_swarm);
+      a.insert(a.end(), {"--drones", std::to_string(n)});
       a.insert(a.end(), dds_args.begin(), dds_args.end());
       return a;
     };
     // Agent hosts: K processes, each flying a contiguous share of the ids.
     const auto shares = agent_host_shares(ids, agent_hosts);
-    for (std::size_t h = 0; h < shares.size(); ++h) {
-      const auto a = agent_args({bin + "/ddswarm-agent", "--ids", shares[h], "--config", scenario,
-                                 "--drones", std::to_string(n)});
-      procs.start({"agent host " + std::to_string(h), a});
-    }
+    for (std::size_t h = 0; h < shares.size(); ++h)
+      procs.start({"agent host " + std::to_string(h), agent_args(shares[h], true)});
     for (int id : agent_hosts > 0 ? std::vector<int>{} : ids) {
-      auto a = agent_args({bin + "/ddswarm-agent", "--id", std::to_string(id), "--config", scenario,
-                           "--drones", std::to_string(n)});
+      auto a = agent_args(std::to_string(id), false);
       if (const int pid = agent_participant_id(n, id); pid >= 0) {
         a.push_back("--participant-id");
         a.push_back(std::to_string(pid));

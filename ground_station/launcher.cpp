@@ -360,6 +360,14 @@ std::vector<std::string> agent_host_shares(const std::vector<int>& ids, int host
   return shares;
 }
 
+std::vector<std::string> agent_command(const std::string& bin, const std::string& ids, bool host,
+                                       const std::string& scenario, bool started_with_server) {
+  std::vector<std::string> a = {bin + "/ddswarm-agent", host ? "--ids" : "--id", ids, "--config",
+                                scenario};
+  if (started_with_server) a.insert(a.end(), {"--duplicate-probe", "0"});
+  return a;
+}
+
 std::string ephemeral_port_warning(int domain, int first_id, int last_id, int lo, int hi) {
   const int low = rtps_unicast_port(domain, first_id), high = rtps_unicast_port(domain, last_id) + 1;
   if (first_id < 0 || last_id < first_id || high < lo || low > hi) return "";

@@ -137,6 +137,17 @@ int agent_participant_id(int drones, int drone_id);
 /// `ddswarm-agent` ("0,1,2"). Fewer shares when there are fewer ids than hosts.
 std::vector<std::string> agent_host_shares(const std::vector<int>& ids, int hosts);
 
+/// The command that starts one agent process: drone `ids` alone (`--id`), or
+/// a share of agent_host_shares as an agent host (`--ids`), reading scenario.
+/// started_with_server: the same tool starts the server and every agent of
+/// the swarm, so no other agent flies these drones and the agent skips its
+/// duplicate probe (`--duplicate-probe 0`). N probe readers each matching N
+/// status writers kept a 128-process swarm from coming up at all
+/// (docs/performance.md, "Bringing up 128 processes"); agents launched apart
+/// from their server keep it.
+std::vector<std::string> agent_command(const std::string& bin, const std::string& ids, bool host,
+                                       const std::string& scenario, bool started_with_server);
+
 /// The RTPS unicast ports (metatraffic and user, 7400 + 250*domain + 10/11 +
 /// 2*id) of explicit participant ids [first_id, last_id] that fall inside the
 /// kernel's ephemeral port range [lo, hi] (/proc/sys/net/ipv4/ip_local_port_range).

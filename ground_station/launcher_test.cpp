@@ -147,6 +147,14 @@ TEST(Launcher, AgentHostSharesSplitTheIdsContiguously) {
   EXPECT_TRUE(agent_host_shares({}, 2).empty());
 }
 
+TEST(Launcher, AgentsStartedWithTheirServerSkipTheDuplicateProbe) {
+  using V = std::vector<std::string>;
+  EXPECT_EQ(agent_command("b", "3", false, "s.yaml", true),
+            (V{"b/ddswarm-agent", "--id", "3", "--config", "s.yaml", "--duplicate-probe", "0"}));
+  EXPECT_EQ(agent_command("b", "0,1,2", true, "s.yaml", false),
+            (V{"b/ddswarm-agent", "--ids", "0,1,2", "--config", "s.yaml"}));
+}
+
 TEST(Launcher, MissingProgramIsAClearError) {
   Launcher l;
   try {

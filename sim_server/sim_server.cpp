@@ -127,8 +127,9 @@ struct SimServer::Impl {
   std::set<std::pair<std::uint64_t, std::uint32_t>> seen_missions;
   bool rejoin = false;  // run() ended on a rejoin request (rejoin_now)
   // Another server's scene on this domain (on_rival_scene): its instance, when
-  // this one is the newcomer and leaves; whether the log said so, when it stays.
-  std::uint64_t rival_instance = 0;
+  // this one is the newcomer and leaves (set under mu, read without it by the
+  // per-turn check); whether the log said so, when it stays.
+  std::atomic<std::uint64_t> rival_instance{0};
   bool rival_logged = false;
   std::int64_t scene_published_ns = 0;  // system clock, as the scene's source timestamp
   bool swarm_silent = false;  // expire_agents: no live agent heard within agent_timeout_s
@@ -821,16 +822,11 @@ struct SimServer::Impl {
         .count();
   }
 
-  bool rival() {
-    std::lock_guard<std::mutex> lock(mu);
-    return rival_instance != 0;
-  }
-
   /// SIGUSR1 (ddswarm-launch: its discovery server dropped this participant's
   /// endpoints, so no agent will ever match them): leave DDS and start again
   /// as a new server, but only before any mission command came.
   bool rejoin_now() {
-    if (rival()) return true;
+    if (rival_instance.load() != 0) return true;
     if (!take_rejoin_request()) return false;
     std::lock_guard<std::mutex> lock(mu);
     if (!seen_missions.empty()) {
@@ -961,7 +957,7 @@ struct SimServer::Impl {
     state_text = "stopping";
     publish_status(true);
     spdlog::info("ddswarm-sim: stopped at tick {} (sim {:.2f} s)", tick, sim_time());
-    if (rival()) return SimServer::End::kRivalServer;
+    if (rival_instance.load() != 0) return SimServer::End::kRivalServer;
     return rejoin ? SimServer::End::kRejoinRequested : SimServer::End::kStopped;
   }
 };
@@ -969,9 +965,6 @@ struct SimServer::Impl {
 SimServer::SimServer(ServerConfig cfg) : impl_(std::make_unique<Impl>(std::move(cfg))) {}
 SimServer::~SimServer() = default;
 SimServer::End SimServer::run(double duration_s) { return impl_->run(duration_s); }
-std::uint64_t SimServer::rival_instance() const {
-  std::lock_guard<std::mutex> lock(impl_->mu);
-  return impl_->rival_instance;
-}
+std::uint64_t SimServer::rival_instance() const { return impl_->rival_instance.load(); }
 
 }  // namespace ddswarm::sim
