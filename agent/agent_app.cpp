@@ -69,6 +69,21 @@ SceneConfig scene_from_msg(const msg::Scene& s) {
   return c;
 }
 
+/// Why a scene cannot be flown (empty when it can): the checks the scene
+/// file gets (SceneConfig::validate), and a control rate. A broken or hostile
+/// Scene sample is refused before anything of it is applied.
+std::string scene_problem(const msg::Scene& s) {
+  if (!(std::isfinite(s.control_rate_hz()) && s.control_rate_hz() > 0 &&
+        s.control_rate_hz() <= 10000))
+    return "control_rate_hz = " + std::to_string(s.control_rate_hz()) + ": must be in (0, 10000]";
+  try {
+    scene_from_msg(s).validate();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
 bool finite(const msg::Vec3& v) {
   return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
 }
@@ -155,6 +170,7 @@ struct AgentApp::Impl {
   std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
   bool loss_logged = false;    // agent.state_loss said so in the log
   bool copy_logged = false;    // a copied scene was refused, and the log said so
+  bool bad_scene_logged = false;  // a scene that cannot be flown was refused, and the log said so
   // This tick's swarm members (live agent, not in failsafe, finite position),
   // by id: converted once per sample for every brain in the process.
   std::vector<PeerObservation> roster;
@@ -263,12 +279,19 @@ struct AgentApp::Impl {
             label, s.server_instance());
       return;
     }
-    server = from;
+    if (const std::string why = scene_problem(s); !why.empty()) {
+      ++rejected;
+      if (!std::exchange(bad_scene_logged, true))
+        spdlog::warn("{}: refused a scene (instance {:016x}) that cannot be flown: {}", label,
+                     s.server_instance(), why);
+      return;
+    }
     const int highest = cfg.drone_ids.empty() ? 0 : *std::max_element(cfg.drone_ids.begin(), cfg.drone_ids.end());
     if (s.num_drones() <= highest) {
       spdlog::error("{}: the server flies only {} drones", label, s.num_drones());
       return;
     }
+    server = from;
     if (scene && s.server_instance() == server_instance) return;  // a re-announcement: keep the mission
     scene_wall = wall_seconds();
     if (scene) {

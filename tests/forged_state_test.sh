@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Issue 3: malformed or foreign swarm samples are ignored and counted by the
 # agent; its drone keeps holding its altitude on the real server's samples,
-# also after another participant republishes the server's scene.
+# also after another participant republishes the server's scene or publishes
+# one that cannot be flown.
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/tests/scenarios/one_drone.yaml"
 start sim "$BIN/ddswarm-sim" --scenario "$scenario" --domain "$DOMAIN"
@@ -14,5 +15,11 @@ timeout 60 "$BIN/forged_swarm_state" --domain "$DOMAIN" --attack 3 --z 2.0 || fa
 timeout 60 "$BIN/forged_swarm_state" --domain "$DOMAIN" --attack 3 --z 2.0 --copy-scene ||
   fail "after a copied scene the agent applied forged samples, or the server lost it"
 grep -q "refused a copy of the server's scene" "$WORK/agent.log" || fail "the agent did not say it refused the copied scene"
+# A scene that cannot be flown (a broken or hostile server's) is refused
+# before any of it applies: the agent once died of it in a Fast DDS thread.
+timeout 60 "$BIN/forged_swarm_state" --domain "$DOMAIN" --attack 3 --z 2.0 --bad-scene ||
+  fail "after a scene that cannot be flown the agent applied forged samples, or the server lost it"
+grep -q "refused a scene (instance [0-9a-f]*) that cannot be flown: scene.bounds_max" "$WORK/agent.log" ||
+  fail "the agent did not say it refused the scene"
 kill -0 "$PID_agent" || fail "the agent died"
 echo PASS
