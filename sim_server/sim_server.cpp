@@ -256,27 +256,46 @@ struct SimServer::Impl {
       if (s.server_instance() != instance)
         on_rival_scene(s.server_instance(), info.source_timestamp.to_ns());
     });
+    dds.reader<msg::SimStatus>([this](const msg::SimStatus& s, const fdds::SampleInfo&) {
+      if (s.server_instance() != instance) on_rival_status(s);
+    });
     publish_scene();
   }
 
   /// Two servers on one domain would fly one swarm in two worlds: the agents
-  /// follow whichever scene they heard first. Each server publishes its scene
-  /// once, as it joins; the one whose scene is the newer is the newcomer and
-  /// leaves (run() ends kRivalServer), even if the other swarm's agents
-  /// already answer it. The other says so once and stays.
+  /// follow whichever scene they heard first. One leaves (run() ends
+  /// kRivalServer), the other says so once and stays:
+  /// - a server that has accepted a mission command never leaves;
+  /// - one that has not leaves when the other's status shows a mission
+  ///   (on_rival_status), whatever the clocks say;
+  /// - between two that have none, each scene's source timestamp (published
+  ///   once, as the server joins) decides: the newer leaves, even if the
+  ///   other swarm's agents already answer it. Hosts' clocks may differ; by
+  ///   the rules above, a swarm in flight never yields to a newcomer.
+  bool mission_begun() const { return !seen_missions.empty(); }  // call with mu held
+
   void on_rival_scene(std::uint64_t other, std::int64_t other_published_ns) {
     std::lock_guard<std::mutex> lock(mu);
     const std::int64_t own = scene_published_ns != 0 ? scene_published_ns : system_now_ns();
-    if (other_published_ns < own) {
-      rival_instance = other;
-      cv.notify_all();
-      return;
-    }
+    if (!mission_begun() && other_published_ns < own) return yield_to(other);
     if (!std::exchange(rival_logged, true))
       spdlog::error(
           "another server (instance {:016x}) is on DDS domain {}: two swarms on one domain "
-          "are one swarm; it should leave (this one stays: it came first)",
-          other, cfg.dds.domain_id);
+          "are one swarm; it should leave (this one stays: {})",
+          other, cfg.dds.domain_id,
+          mission_begun() ? "its swarm has a mission" : "it joined first");
+  }
+
+  void on_rival_status(const msg::SimStatus& s) {
+    std::lock_guard<std::mutex> lock(mu);
+    const auto& seqs = s.mission_seq();
+    if (!mission_begun() && std::any_of(seqs.begin(), seqs.end(), [](auto q) { return q != 0; }))
+      yield_to(s.server_instance());
+  }
+
+  void yield_to(std::uint64_t other) {  // call with mu held
+    rival_instance = other;
+    cv.notify_all();
   }
 
   // ---- DDS callbacks (Fast DDS threads) ----

@@ -6,6 +6,10 @@ target_link_libraries(hostile_publisher PRIVATE ddswarm_common)
 
 ddswarm_process_test(mp_hostile_samples 60 hostile_samples_test.sh)
 ddswarm_process_test(mp_duplicate_agent 90 duplicate_agent_test.sh)
+# A second server whose host's clock is off: a swarm with a mission never yields to it.
+add_executable(rival_server rival_server.cpp)
+target_link_libraries(rival_server PRIVATE ddswarm_common)
+ddswarm_process_test(mp_rival_server 60 rival_server_test.sh)
 ddswarm_process_test(mp_config_errors 60 config_errors_test.sh)
 ddswarm_process_test(mp_network_safety 60 network_safety_test.sh)
 set_tests_properties(mp_network_safety PROPERTIES SKIP_RETURN_CODE 77)
