@@ -179,6 +179,7 @@ ProcessParticipants& process_participants() {
 }
 
 std::atomic<std::uint64_t> g_write_throws{0};
+std::atomic<std::uint64_t> g_handler_throws{0};
 
 }  // namespace
 
@@ -194,6 +195,18 @@ bool write_threw(fdds::DataWriter* w, const std::exception& e) {
 }
 
 std::uint64_t write_throws() { return g_write_throws.load(); }
+
+void handler_threw(fdds::DataReader* r, const std::exception& e) {
+  const std::uint64_t n = ++g_handler_throws;
+  if (std::has_single_bit(n)) {
+    const fdds::TopicDescription* t = r ? r->get_topicdescription() : nullptr;
+    spdlog::error(
+        "a {} sample could not be handled ({} so far in this process), dropped; carrying on: {}",
+        t ? t->get_name() : std::string("DDS"), n, e.what());
+  }
+}
+
+std::uint64_t handler_throws() { return g_handler_throws.load(); }
 
 eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
                                                           std::uint32_t n) {

@@ -46,6 +46,15 @@ bool write_threw(fdds::DataWriter* w, const std::exception& e);
 /// How many writes have thrown in this process (write_threw).
 std::uint64_t write_throws();
 
+/// Records a sample whose handler threw on a Fast DDS thread (where the
+/// exception would end the process in std::terminate): the sample is dropped
+/// and the reader goes on. Logged at the first and at every power of two;
+/// handlers should refuse what they cannot apply themselves (and count it),
+/// so this is the last guard, not the rule.
+void handler_threw(fdds::DataReader* r, const std::exception& e);
+/// How many samples' handlers have thrown in this process (handler_threw).
+std::uint64_t handler_throws();
+
 template <class T>
 class Writer {
  public:
@@ -108,7 +117,12 @@ class Reader : public fdds::DataReaderListener {
     std::lock_guard<std::mutex> lock(sample_mu_);
     fdds::SampleInfo info;
     while (reader->take_next_sample(&sample_, &info) == ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data && handler_) handler_(sample_, info);
+      if (!info.valid_data || !handler_) continue;
+      try {
+        handler_(sample_, info);
+      } catch (const std::exception& e) {
+        handler_threw(reader, e);
+      }
     }
   }
   void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {

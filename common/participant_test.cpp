@@ -289,5 +289,35 @@ TEST(Participant, AWriteThatThrowsIsCountedAndTheWriterGoesOn) {
   p.raw()->delete_topic(topic);
 }
 
+// A handler that throws on a Fast DDS thread would end the process in
+// std::terminate (a Scene that could not be flown once killed an agent so):
+// the sample is dropped and counted, and the next one is handled.
+TEST(Participant, AHandlerThatThrowsDropsItsSampleAndTheReaderGoesOn) {
+  std::atomic<int> handled{0};  // outlives the participants' callbacks
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant server(cfg, "participant_test writer");
+  Participant agent(cfg, "participant_test reader");
+  auto w = server.writer<msg::SimStatus>();
+  auto& r = agent.reader<msg::SimStatus>([&](const msg::SimStatus& s, const fdds::SampleInfo&) {
+    if (s.tick() % 2 == 1) throw std::runtime_error("scene.bounds_max = 0 0 0: must exceed");
+    ++handled;
+  });
+  ASSERT_TRUE(within(10, [&] { return w.matched() == 1 && r.matched() == 1; }));
+  const std::uint64_t before = handler_throws();
+  msg::SimStatus s;
+  for (std::uint64_t k = 1; k <= 4; ++k) {  // odd ticks throw, even ones are handled
+    s.tick(k);
+    ASSERT_TRUE(w.write(s));
+    ASSERT_TRUE(within(10, [&] { return handler_throws() - before + handled.load() == k; }))
+        << "sample " << k << ": " << handler_throws() - before << " thrown, " << handled.load()
+        << " handled";
+  }
+  EXPECT_EQ(handler_throws() - before, 2u);
+  EXPECT_EQ(handled.load(), 2);
+  server.close();
+  agent.close();
+}
+
 }  // namespace
 }  // namespace ddswarm
