@@ -8,7 +8,9 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -45,8 +47,9 @@ std::vector<std::string> words(const std::string& s) {
 }
 
 /// Runs a child in the foreground with this terminal; returns its exit status.
-int run_foreground(const std::vector<std::string>& argv, Launcher& procs, bool stop_on_death,
-                   bool& died) {
+/// deaths() reaps the other children and says whether to stop.
+int run_foreground(const std::vector<std::string>& argv, Launcher& procs,
+                   const std::function<bool()>& deaths) {
   pid_t pid = fork();
   if (pid == 0) {
     unblock_signals_for_exec();
@@ -58,11 +61,7 @@ int run_foreground(const std::vector<std::string>& argv, Launcher& procs, bool s
   }
   int status = 0;
   while (waitpid(pid, &status, WNOHANG) == 0) {
-    for (const auto& e : procs.reap()) {
-      std::cerr << "ddswarm-launch: " << e.describe() << "\n";
-      died = true;
-      if (stop_on_death) kill(pid, SIGTERM);
-    }
+    if (deaths()) kill(pid, SIGTERM);
     if (stop_requested()) kill(pid, SIGINT);
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
@@ -92,8 +91,10 @@ int main(int argc, char** argv) {
                    "fly the agents in K agent-host processes (ddswarm-agent --ids) instead of one process per drone")
         ->check(CLI::Range(1, 1024));
     app.add_option("--on-death", on_death,
-                   "when a process dies: stop (stop everything, exit 1) | keep (report, keep flying)")
-        ->check(CLI::IsMember({"stop", "keep"}));
+                   "when a process dies: stop (stop everything, exit 1) | keep (report, keep "
+                   "flying) | restart (start a crashed agent again, up to 3 times each; it "
+                   "rejoins the mission in force; anything else that dies stops everything)")
+        ->check(CLI::IsMember({"stop", "keep", "restart"}));
     app.add_option("--gs", gs_script,
                    "ground-station commands to run once every agent is online, e.g. \"takeoff --wait; task\"; "
                    "everything stops when they finish");
@@ -177,7 +178,7 @@ int main(int argc, char** argv) {
       dds_args.push_back(std::string("--best-effort-streams=") + (dds_cli.best_effort_streams ? "true" : "false"));
     const std::string bin = Launcher::self_dir();
     install_stop_signals();
-    const bool stop_on_death = on_death == "stop";
+    const bool stop_on_death = on_death != "keep";
     Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
     const bool localhost_discovery = file.dds.discovery == Discovery::kLocalhost &&
                                      !app.count("--dds-interface") && !app.count("--dds-peers");
@@ -250,20 +251,42 @@ int main(int argc, char** argv) {
     };
     // Agent hosts: K processes, each flying a contiguous share of the ids.
     const auto shares = agent_host_shares(ids, agent_hosts);
+    std::map<std::string, ChildSpec> agents;  // by name: what --on-death restart starts again
+    const auto start_agent = [&](ChildSpec spec) {
+      procs.start(spec);
+      agents[spec.name] = std::move(spec);
+    };
     for (std::size_t h = 0; h < shares.size(); ++h)
-      procs.start({"agent host " + std::to_string(h), agent_args(shares[h], true)});
+      start_agent({"agent host " + std::to_string(h), agent_args(shares[h], true)});
     for (int id : agent_hosts > 0 ? std::vector<int>{} : ids) {
       auto a = agent_args(std::to_string(id), false);
       if (const int pid = agent_participant_id(n, id); pid >= 0) {
         a.push_back("--participant-id");
         a.push_back(std::to_string(pid));
       }
-      procs.start({"agent " + std::to_string(id), a});
+      start_agent({"agent " + std::to_string(id), a});
     }
     std::cerr << fmt::format("ddswarm-launch: started {} process(es); policy on death: {}\n",
                              procs.running(), on_death);
     int rc = 0;
-    bool died = false;
+    bool died = false;  // a process died and was not started again
+    std::map<std::string, int> restarts;
+    // Reaps the children that ended, applies --on-death, and says whether to stop.
+    const auto deaths = [&] {
+      for (const auto& e : procs.reap()) {
+        std::cerr << "ddswarm-launch: " << e.describe() << "\n";
+        const auto spec = agents.find(e.name);
+        if (on_death == "restart" && spec != agents.end() && worth_restarting(e) &&
+            restarts[e.name] < kMaxRestarts) {
+          std::cerr << fmt::format("ddswarm-launch: restarting {} ({} of {})\n", e.name,
+                                   ++restarts[e.name], kMaxRestarts);
+          procs.start(spec->second);
+          continue;
+        }
+        died = true;
+      }
+      return died && stop_on_death;
+    };
     auto gs_argv = [&](const std::vector<std::string>& sub) {
       std::vector<std::string> a = {bin + "/ddswarm-gs", "--config", scenario};
       a.insert(a.end(), dds_args.begin(), dds_args.end());
@@ -276,22 +299,18 @@ int main(int argc, char** argv) {
       for (const auto& step : steps) {
         if (stop_requested() || (died && stop_on_death)) break;
         std::cerr << "ddswarm-launch: gs " << step << "\n";
-        rc = run_foreground(gs_argv(words(step)), procs, stop_on_death, died);
+        rc = run_foreground(gs_argv(words(step)), procs, deaths);
         if (rc != 0) {
           std::cerr << fmt::format("ddswarm-launch: 'ddswarm-gs {}' failed (exit {})\n", step, rc);
           break;
         }
       }
     } else if (gs_interactive) {
-      rc = run_foreground(gs_argv({"menu"}), procs, stop_on_death, died);
+      rc = run_foreground(gs_argv({"menu"}), procs, deaths);
     } else {
       double end = duration_s > 0 ? wall_seconds() + duration_s : 1e300;
       while (!stop_requested() && wall_seconds() < end && procs.running() > 0) {
-        for (const auto& e : procs.reap()) {
-          std::cerr << "ddswarm-launch: " << e.describe() << "\n";
-          died = true;
-        }
-        if (died && stop_on_death) break;
+        if (deaths()) break;
         wait_for_stop(std::chrono::milliseconds(100));
       }
     }

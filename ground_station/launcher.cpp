@@ -139,7 +139,12 @@ pid_t Launcher::start(const ChildSpec& spec) {
     std::string file = spec.name;
     for (auto& ch : file)
       if (ch == ' ' || ch == '/') ch = '_';
-    c->log = fopen((log_dir_ + "/" + file + ".log").c_str(), "w");
+    bool again = false;  // a restart: keep what the earlier run wrote
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      again = !logs_opened_.insert(file).second;
+    }
+    c->log = fopen((log_dir_ + "/" + file + ".log").c_str(), again ? "a" : "w");
   }
   {
     std::lock_guard<std::mutex> lock(mu_);
@@ -358,6 +363,11 @@ std::vector<std::string> agent_host_shares(const std::vector<int>& ids, int host
     shares.push_back(share);
   }
   return shares;
+}
+
+bool worth_restarting(const ChildExit& e) {
+  if (e.signal != 0) return true;
+  return e.exit_code != 0 && e.exit_code != 2 && e.exit_code != 3;
 }
 
 std::vector<std::string> agent_command(const std::string& bin, const std::string& ids, bool host,

@@ -33,6 +33,16 @@ struct ChildExit {
   std::string describe() const;  ///< "agent 3 (pid 1234) exited with code 1" / "was killed by SIGKILL"
 };
 
+/// --on-death restart: whether an agent's end is one that starting it again
+/// can mend. A signal (a crash such as Fast DDS 2.9.1's assertion in
+/// docs/faults.md, an OOM kill, a SIGKILL) or an unexpected exit code is;
+/// exit 0 (its --duration), 2 (its configuration) and 3 (another agent flies
+/// its drone) are not, since they would recur. The launcher's own SIGTERM
+/// never reaches this: it reaps nothing while stopping.
+bool worth_restarting(const ChildExit& e);
+/// How many times --on-death restart starts one agent again.
+constexpr int kMaxRestarts = 3;
+
 /// Runs spec to its end and returns how it ended; output gets its stdout and
 /// stderr together. For quick checks (`ddswarm-sim --check`): no timeout, no
 /// supervision. Throws std::runtime_error when it cannot start.
@@ -48,6 +58,7 @@ class Launcher {
   Launcher& operator=(const Launcher&) = delete;
 
   /// Forks and execs; throws std::runtime_error naming the program on failure.
+  /// A name started before (a restart) appends to its log file.
   pid_t start(const ChildSpec& spec);
   /// Children that ended since the last call (never blocks).
   std::vector<ChildExit> reap();
@@ -84,6 +95,7 @@ class Launcher {
   std::set<std::array<std::uint8_t, 12>> dropped_seen_;  ///< participants already acted on
 
   std::string log_dir_;
+  std::set<std::string> logs_opened_;  ///< log files of this launcher's children so far
   mutable std::mutex mu_;
   std::map<pid_t, std::unique_ptr<Child>> live_;
   std::vector<std::unique_ptr<Child>> closed_;

@@ -155,6 +155,16 @@ TEST(Launcher, AgentsStartedWithTheirServerSkipTheDuplicateProbe) {
             (V{"b/ddswarm-agent", "--ids", "0,1,2", "--config", "s.yaml"}));
 }
 
+TEST(Launcher, RestartsOnlyWhatStartingAgainCanMend) {
+  const auto exit_with = [](int code) { return ChildExit{"agent 2", 42, code, 0}; };
+  EXPECT_TRUE(worth_restarting(ChildExit{"agent 2", 42, -1, SIGABRT}));  // a crash
+  EXPECT_TRUE(worth_restarting(ChildExit{"agent 2", 42, -1, SIGKILL}));  // an OOM kill, a user
+  EXPECT_TRUE(worth_restarting(exit_with(1)));                            // an error at run time
+  EXPECT_FALSE(worth_restarting(exit_with(0)));  // its --duration ended
+  EXPECT_FALSE(worth_restarting(exit_with(2)));  // its configuration: it would fail again
+  EXPECT_FALSE(worth_restarting(exit_with(3)));  // another agent flies its drone
+}
+
 TEST(Launcher, MissingProgramIsAClearError) {
   Launcher l;
   try {
