@@ -181,29 +181,34 @@ ProcessParticipants& process_participants() {
 std::atomic<std::uint64_t> g_write_throws{0};
 std::atomic<std::uint64_t> g_handler_throws{0};
 
+/// Counts one more failure; returns the count when it deserves a log line
+/// (the first, then each power of two), 0 otherwise.
+std::uint64_t count_for_log(std::atomic<std::uint64_t>& failures) {
+  const std::uint64_t n = ++failures;
+  return std::has_single_bit(n) ? n : 0;
+}
+
+std::string topic_name(const fdds::TopicDescription* t) {
+  return t ? t->get_name() : std::string("an unknown topic");
+}
+
 }  // namespace
 
 bool write_threw(fdds::DataWriter* w, const std::exception& e) {
-  const std::uint64_t n = ++g_write_throws;
-  if (std::has_single_bit(n)) {
-    const fdds::Topic* t = w ? w->get_topic() : nullptr;
+  if (const std::uint64_t n = count_for_log(g_write_throws))
     spdlog::warn(
         "a DDS write on {} threw ({} so far in this process), its sample lost; carrying on: {}",
-        t ? t->get_name() : std::string("an unknown topic"), n, e.what());
-  }
+        topic_name(w ? w->get_topic() : nullptr), n, e.what());
   return false;
 }
 
 std::uint64_t write_throws() { return g_write_throws.load(); }
 
 void handler_threw(fdds::DataReader* r, const std::exception& e) {
-  const std::uint64_t n = ++g_handler_throws;
-  if (std::has_single_bit(n)) {
-    const fdds::TopicDescription* t = r ? r->get_topicdescription() : nullptr;
+  if (const std::uint64_t n = count_for_log(g_handler_throws))
     spdlog::error(
-        "a {} sample could not be handled ({} so far in this process), dropped; carrying on: {}",
-        t ? t->get_name() : std::string("DDS"), n, e.what());
-  }
+        "a sample of {} could not be handled ({} so far in this process), dropped; carrying on: {}",
+        topic_name(r ? r->get_topicdescription() : nullptr), n, e.what());
 }
 
 std::uint64_t handler_throws() { return g_handler_throws.load(); }
