@@ -18,9 +18,11 @@
 #include "agent/mission_fsm.hpp"
 #include "agent/peer_source.hpp"
 #include "agent/swarm_law.hpp"
+#include "common/config_error.hpp"
 #include "common/convert.hpp"
 #include "common/participant.hpp"
 #include "common/process.hpp"
+#include "common/scene.hpp"
 
 namespace ddswarm::agent {
 
@@ -70,13 +72,12 @@ SceneConfig scene_from_msg(const msg::Scene& s) {
 }
 
 /// Why a scene cannot be flown (empty when it can): the checks the scene
-/// file gets (SceneConfig::validate), and a control rate. A broken or hostile
-/// Scene sample is refused before anything of it is applied.
+/// file gets (SceneConfig::validate), and the control rates a server flies.
+/// A broken or hostile Scene sample is refused before anything of it is applied.
 std::string scene_problem(const msg::Scene& s) {
-  if (!(std::isfinite(s.control_rate_hz()) && s.control_rate_hz() > 0 &&
-        s.control_rate_hz() <= 10000))
-    return "control_rate_hz = " + std::to_string(s.control_rate_hz()) + ": must be in (0, 10000]";
   try {
+    check_range("scene.control_rate_hz", s.control_rate_hz(), kMinControlRateHz,
+                kMaxControlRateHz);
     scene_from_msg(s).validate();
   } catch (const std::exception& e) {
     return e.what();

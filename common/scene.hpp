@@ -41,6 +41,11 @@ struct StartConfig {
   std::vector<Eigen::Vector3d> positions;    ///< kExplicit: one per drone (z = 0 on ground)
 };
 
+/// The control rates a server flies (sim.control_rate_hz), and an agent
+/// accepts in a scene: one tick per control period.
+constexpr double kMinControlRateHz = 1.0;
+constexpr double kMaxControlRateHz = 1000.0;
+
 struct SceneConfig {
   double ground_z_m = 0.0;                   ///< m, height of the ground plane
   std::vector<Cylinder> cylinders;

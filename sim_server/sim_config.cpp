@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "common/scene.hpp"
+
 namespace ddswarm::sim {
 
 void load(YamlSection s, SimConfig& c) {
@@ -33,7 +35,7 @@ bool divides(double big, double small) {
 
 void SimConfig::validate() const {
   check_range("sim.physics_rate_hz", physics_rate_hz, 50.0, 20000.0);
-  check_range("sim.control_rate_hz", control_rate_hz, 1.0, 1000.0);
+  check_range("sim.control_rate_hz", control_rate_hz, kMinControlRateHz, kMaxControlRateHz);
   if (!divides(physics_rate_hz, control_rate_hz))
     throw FieldError("sim.control_rate_hz", to_text(control_rate_hz),
                      "must divide physics_rate_hz (" + to_text(physics_rate_hz) + ")");
