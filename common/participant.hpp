@@ -197,7 +197,13 @@ class Participant {
     fdds::DataReaderQos q;
     if (sub->get_datareader_qos_from_profile(Topic<T>::profile, q) == ReturnCode_t::RETCODE_OK) {
       if (delivery == Delivery::kLatest) q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
-      if (!shared_memory_ || delivery == Delivery::kArchive) q.data_sharing().off();
+      // Never a VOLATILE reader by data-sharing, even from a user's profile
+      // file: Fast DDS 2.9.1 aborts the process when one matches a writer
+      // that writes meanwhile (ReaderPool.hpp:141, docs/dds.md). The swarm
+      // state's readers are transient-local instead (config/dds_profiles.xml).
+      if (!shared_memory_ || delivery == Delivery::kArchive ||
+          q.durability().kind == fdds::VOLATILE_DURABILITY_QOS)
+        q.data_sharing().off();
       r = sub->create_datareader(topic, q, listener.get());
     }
     if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));

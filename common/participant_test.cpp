@@ -9,7 +9,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <stdexcept>
@@ -317,6 +319,97 @@ TEST(Participant, AHandlerThatThrowsDropsItsSampleAndTheReaderGoesOn) {
   EXPECT_EQ(handled.load(), 2);
   server.close();
   agent.close();
+}
+
+// Fast DDS 2.9.1 asserts (ReaderPool.hpp:141, next_payload_ == end()) when a
+// VOLATILE reader matches a data-sharing writer that writes while the reader
+// skips its history: an agent joining a swarm whose server publishes 50
+// states a second once died so. Readers made and removed under a writer that
+// never stops writing must all live, and each must hear it.
+TEST(Participant, ReadersJoiningABusyDataSharingWriterLive) {
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> written{0};
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant server(cfg, "participant_test busy writer");
+  Participant agent(cfg, "participant_test joining readers");
+  auto w = server.writer<msg::SwarmState>();
+  std::thread writer([&] {
+    msg::SwarmState s;
+    s.drones().resize(6);
+    for (std::uint64_t k = 1; !stop.load(); ++k) {
+      s.tick(k);
+      w.write(s);
+      written = k;
+    }
+  });
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(8);
+  int joins = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    std::atomic<int> got{0};
+    auto& r = agent.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got; },
+                                            std::nullopt, Delivery::kLatest);
+    ASSERT_TRUE(within(10, [&] { return got.load() > 0; })) << "join " << joins << " heard nothing";
+    agent.remove(r);
+    ++joins;
+  }
+  stop = true;
+  writer.join();
+  std::printf("%d readers joined a writer that wrote %llu states\n", joins,
+              static_cast<unsigned long long>(written.load()));
+  server.close();
+  agent.close();
+}
+
+// What a reader joining a running swarm gets first: the newest state, at
+// once (transient-local, the writer keeping one), never an older one; then
+// each new state as it comes.
+TEST(Participant, AJoiningStateReaderGetsTheNewestStateOnly) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant server(cfg, "participant_test writer");
+  Participant first(cfg, "participant_test first reader");
+  auto w = server.writer<msg::SwarmState>();
+  std::atomic<int> heard{0};
+  auto& r0 = first.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++heard; });
+  ASSERT_TRUE(within(10, [&] { return w.matched() == 1 && r0.matched() == 1; }));
+  msg::SwarmState s;
+  for (std::uint64_t k = 1; k <= 10; ++k) {
+    s.tick(k);
+    ASSERT_TRUE(w.write(s));
+  }
+  ASSERT_TRUE(within(10, [&] { return heard.load() > 0; }));  // written, and delivered
+  std::uint64_t newest = 10;
+  for (const Delivery d : {Delivery::kProfile, Delivery::kLatest}) {
+    Participant agent(cfg, "participant_test joining reader");
+    std::mutex mu;
+    std::vector<std::uint64_t> ticks;
+    auto& r = agent.reader<msg::SwarmState>(
+        [&](const msg::SwarmState& got, const fdds::SampleInfo&) {
+          std::lock_guard<std::mutex> lock(mu);
+          ticks.push_back(got.tick());
+        },
+        std::nullopt, d);
+    ASSERT_TRUE(within(10, [&] {
+      std::lock_guard<std::mutex> lock(mu);
+      return !ticks.empty();
+    }));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // anything older would be here by now
+    s.tick(newest + 1);
+    ASSERT_TRUE(w.write(s));
+    ASSERT_TRUE(within(10, [&] {
+      std::lock_guard<std::mutex> lock(mu);
+      return ticks.size() >= 2;
+    }));
+    std::lock_guard<std::mutex> lock(mu);
+    EXPECT_EQ(ticks, (std::vector<std::uint64_t>{newest, newest + 1}))
+        << (d == Delivery::kLatest ? "best-effort" : "reliable") << " reader";
+    ++newest;
+    agent.remove(r);
+    agent.close();
+  }
+  server.close();
+  first.close();
 }
 
 }  // namespace
