@@ -19,6 +19,7 @@
 #include "ground_station/gs_app.hpp"
 #include "ground_station/line_reader.hpp"
 #include "ground_station/menu.hpp"
+#include "ground_station/rejoining_commander.hpp"
 #include "ground_station/report.hpp"
 #include "ground_station/trace.hpp"
 #include "ground_station/web/web_bridge.hpp"
@@ -316,7 +317,17 @@ int main(int argc, char** argv) {
       mo.max_duration_s = file.gs.max_input_time_s;
       mo.default_task_speed_mps = file.task.speed_mps;
       mo.task_epsilon_m = file.task.epsilon_m;
-      return run_menu(gs, reader, std::cout, mo);
+      // Left at its prompt (Ctrl-Z, then fg) for longer than its lease, the
+      // console joins again as a new participant before its next command.
+      RejoiningCommander console(
+          std::move(commander),
+          [&file]() -> std::unique_ptr<Commander> {
+            auto fresh = std::make_unique<DdsCommander>(file.gs, file.dds);
+            fresh->wait_for_server(file.gs.discovery_timeout_s);
+            return fresh;
+          },
+          file.dds.lease_duration_s, std::cerr);
+      return run_menu(console, reader, std::cout, mo);
     }
     if (*wait_agents) {
       // The server's view decides: the next command is another process, which
