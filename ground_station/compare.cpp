@@ -24,6 +24,33 @@ std::map<std::uint64_t, double> times_by_seed(const std::vector<RunRecord>& reco
   return out;
 }
 
+/// Successful runs' task times of one set, every run.
+std::vector<double> successful_times(const std::vector<RunRecord>& records, const std::string& set) {
+  std::vector<double> out;
+  for (const auto& r : records)
+    if (r.set_name == set && r.ok && std::isfinite(r.task_time_s)) out.push_back(r.task_time_s);
+  return out;
+}
+
+/// P(U <= u) for samples of m and n values without ties, every arrangement
+/// of the pooled ranks equally likely. count[i][k]: the arrangements of i
+/// values of the first sample and j of the second with U = k, built up over
+/// j (the largest value is either the first's, beating all j, or not).
+double exact_u_cdf(std::size_t m, std::size_t n, double u) {
+  const std::size_t top = m * n;
+  std::vector<std::vector<double>> count(m + 1, std::vector<double>(top + 1, 0.0));
+  for (auto& c : count) c[0] = 1;  // j = 0: one arrangement, U = 0
+  for (std::size_t j = 1; j <= n; ++j)
+    for (std::size_t i = 1; i <= m; ++i)
+      for (std::size_t k = top + 1; k-- > j;) count[i][k] += count[i - 1][k - j];
+  double below = 0, all = 0;
+  for (std::size_t k = 0; k <= top; ++k) {
+    all += count[m][k];
+    if (static_cast<double>(k) <= u + 1e-9) below += count[m][k];
+  }
+  return below / all;
+}
+
 std::string mean_sd(const SetSummary& s) {
   if (s.runs == 0) return "absent";
   const int ok = s.successes;
@@ -65,6 +92,50 @@ double t_critical_5pct(double df) {
   return z + g1 / df + g2 / (df * df) + g3 / std::pow(df, 3) + g4 / std::pow(df, 4);
 }
 
+RankTest mann_whitney(const std::vector<double>& a, const std::vector<double>& b) {
+  RankTest r;
+  const std::size_t m = a.size(), n = b.size();
+  if (m == 0 || n == 0) return r;
+  // Pooled ranks, ties sharing their mean rank.
+  std::vector<std::pair<double, bool>> pooled;  // value, from a
+  for (double v : a) pooled.emplace_back(v, true);
+  for (double v : b) pooled.emplace_back(v, false);
+  std::sort(pooled.begin(), pooled.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  const double total = static_cast<double>(m + n);
+  double rank_sum_a = 0, tie_term = 0;
+  bool ties = false;
+  for (std::size_t i = 0; i < pooled.size();) {
+    std::size_t j = i;
+    while (j < pooled.size() && pooled[j].first == pooled[i].first) ++j;
+    const double t = static_cast<double>(j - i);
+    const double mean_rank = (static_cast<double>(i + 1) + static_cast<double>(j)) / 2;
+    for (std::size_t k = i; k < j; ++k)
+      if (pooled[k].second) rank_sum_a += mean_rank;
+    if (t > 1) ties = true;
+    tie_term += t * t * t - t;
+    i = j;
+  }
+  const double dm = static_cast<double>(m), dn = static_cast<double>(n);
+  r.u = rank_sum_a - dm * (dm + 1) / 2;
+  if (!ties && m <= kExactRankTestMax && n <= kExactRankTestMax) {
+    // The distribution of U is symmetric about mn/2: P(U >= u) = P(U <= mn - u).
+    const double lower = exact_u_cdf(m, n, std::min(r.u, dm * dn - r.u));
+    r.p = std::min(1.0, 2 * lower);
+    r.exact = true;
+    return r;
+  }
+  const double mu = dm * dn / 2;
+  const double var = dm * dn / 12 * ((total + 1) - tie_term / (total * (total - 1)));
+  if (!(var > 0)) {  // every value the same: nothing tells the samples apart
+    r.p = 1;
+    return r;
+  }
+  const double z = std::max(0.0, std::abs(r.u - mu) - 0.5) / std::sqrt(var);
+  r.p = std::min(1.0, std::erfc(z / std::sqrt(2.0)));
+  return r;
+}
+
 std::vector<SetComparison> compare_sets(const std::vector<RunRecord>& base,
                                         const std::vector<RunRecord>& other) {
   const auto sb = summarize(base), so = summarize(other);
@@ -94,6 +165,7 @@ std::vector<SetComparison> compare_sets(const std::vector<RunRecord>& base,
         c.significant = std::abs(c.welch_t) > t_critical_5pct(c.welch_df);
       }
     }
+    c.rank = mann_whitney(successful_times(base, name), successful_times(other, name));
     const auto tb = times_by_seed(base, name), to = times_by_seed(other, name);
     double sum = 0, most = 0;
     for (const auto& [seed, t] : tb) {
@@ -114,15 +186,22 @@ std::string comparison_table(const std::vector<SetComparison>& sets, const std::
                              const std::string& other_label) {
   std::ostringstream md;
   md << "| set | " << md_text(base_label) << " | " << md_text(other_label)
-     << " | difference | Welch t (df) | at 5 % | same seed: mean (max) absolute difference "
+     << " | difference | Welch t (df) | at 5 % | Mann–Whitney p | at 5 % "
+        "| same seed: mean (max) absolute difference "
         "| collisions per run | min inter-drone distance |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n";
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : sets) {
     const bool tested = std::isfinite(c.welch_t);
     md << "| " << md_text(c.name) << " | " << mean_sd(c.base) << " | " << mean_sd(c.other) << " | "
        << or_na(c.mean_diff_s, "{:+.2f} s") << " | "
        << (tested ? fmt::format("{:+.2f} ({:.0f})", c.welch_t, c.welch_df) : "n/a") << " | "
        << (tested ? (c.significant ? "**DIFFERENT**" : "same") : "n/a") << " | "
+       << (std::isfinite(c.rank.p)
+               ? fmt::format("{:.3g}{}", c.rank.p, c.rank.exact ? " (exact)" : "")
+               : "n/a")
+       << " | "
+       << (std::isfinite(c.rank.p) ? (c.rank.p < 0.05 ? "**DIFFERENT**" : "same") : "n/a")
+       << " | "
        << (c.paired_runs ? fmt::format("{:.2f} ({:.2f}) s, {} runs", c.paired_mean_abs_s,
                                        c.paired_max_abs_s, c.paired_runs)
                          : "none")
