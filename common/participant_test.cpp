@@ -347,8 +347,9 @@ TEST(Participant, ReadersJoiningABusyDataSharingWriterLive) {
   int joins = 0;
   while (std::chrono::steady_clock::now() < end) {
     std::atomic<int> got{0};
-    auto& r = agent.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got; },
-                                            std::nullopt, Delivery::kLatest);
+    auto& r = agent.reader<msg::SwarmState>(
+        [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got; }, std::nullopt,
+        Delivery::kLatest);
     ASSERT_TRUE(within(10, [&] { return got.load() > 0; })) << "join " << joins << " heard nothing";
     agent.remove(r);
     ++joins;
@@ -371,7 +372,8 @@ TEST(Participant, AJoiningStateReaderGetsTheNewestStateOnly) {
   Participant first(cfg, "participant_test first reader");
   auto w = server.writer<msg::SwarmState>();
   std::atomic<int> heard{0};
-  auto& r0 = first.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++heard; });
+  auto& r0 = first.reader<msg::SwarmState>(
+      [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++heard; });
   ASSERT_TRUE(within(10, [&] { return w.matched() == 1 && r0.matched() == 1; }));
   msg::SwarmState s;
   for (std::uint64_t k = 1; k <= 10; ++k) {
@@ -394,7 +396,8 @@ TEST(Participant, AJoiningStateReaderGetsTheNewestStateOnly) {
       std::lock_guard<std::mutex> lock(mu);
       return !ticks.empty();
     }));
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // anything older would be here by now
+    // Anything older would be here by now.
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
     s.tick(newest + 1);
     ASSERT_TRUE(w.write(s));
     ASSERT_TRUE(within(10, [&] {

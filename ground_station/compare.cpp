@@ -25,7 +25,8 @@ std::map<std::uint64_t, double> times_by_seed(const std::vector<RunRecord>& reco
 }
 
 /// Successful runs' task times of one set, every run.
-std::vector<double> successful_times(const std::vector<RunRecord>& records, const std::string& set) {
+std::vector<double> successful_times(const std::vector<RunRecord>& records,
+                                     const std::string& set) {
   std::vector<double> out;
   for (const auto& r : records)
     if (r.set_name == set && r.ok && std::isfinite(r.task_time_s)) out.push_back(r.task_time_s);

@@ -19,7 +19,8 @@ namespace ddswarm::gs {
 
 /// The Mann–Whitney U test of two samples, two-sided.
 struct RankTest {
-  double u = std::numeric_limits<double>::quiet_NaN();  ///< U of the first sample: pairs it wins, ties half
+  /// U of the first sample: the pairs it wins, ties counting half.
+  double u = std::numeric_limits<double>::quiet_NaN();
   double p = std::numeric_limits<double>::quiet_NaN();  ///< two-sided p (NaN: a sample is empty)
   bool exact = false;  ///< p from the exact distribution of U, not the normal approximation
 };

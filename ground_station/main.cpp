@@ -235,8 +235,8 @@ int main(int argc, char** argv) {
     compare->add_option("--plot", cmp_plot,
                         "write DIR/compare.png and .svg: every CSV's mean and spread per set");
     compare->add_flag("--fail-if-different", cmp_fail,
-                      "exit 1 when a set's mean differs at the 5 % level (Welch's t; the rank test is "
-                      "printed beside it)");
+                      "exit 1 when a set's mean differs at the 5 % level (Welch's t; the rank "
+                      "test is printed beside it)");
 
     try {
       app.parse(argc, argv);

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 namespace ddswarm::gs {
 namespace {
@@ -41,7 +42,8 @@ struct Rig {
   std::ostringstream log;
   RejoiningCommander gs{std::make_unique<Numbered>(1),
                         [this]() -> std::unique_ptr<Commander> {
-                          if (std::exchange(fail_next_join, false)) throw std::runtime_error("no DDS");
+                          if (std::exchange(fail_next_join, false))
+                            throw std::runtime_error("no DDS");
                           return std::make_unique<Numbered>(++made);
                         },
                         3.0, log, [this] { return now.load(); }, 0.002};
