@@ -84,7 +84,8 @@ class DdsCommander final : public Commander {
   /// one. False on timeout (e.g. no task was ever run).
   bool wait_task_status(double timeout_s);
   SwarmStatus status() override;
-  /// Every drone as the next swarm state shows it (waits up to timeout_s);
+  /// Every drone as the latest swarm state shows it (the first call waits up
+  /// to timeout_s; a new reader gets the server's newest state at once);
   /// nullopt if none came. Read on this ground station's own participant,
   /// already matched with the server: no second join just to look.
   std::optional<SwarmSnapshot> swarm_snapshot(double timeout_s);
