@@ -220,11 +220,15 @@ TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
 // /dev/shm named by the RTPS port: every other sample then goes over UDP.
 TEST(Participant, WithoutTheShmTransportTheSwarmStateStillComesByDataSharing) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
-  cfg.participant_id = 100 + static_cast<int>(random_instance() % 100);
-  const std::filesystem::path port =
-      "/dev/shm/fastrtps_port" +
-      std::to_string(rtps_unicast_port(cfg.domain_id, cfg.participant_id));
+  std::filesystem::path port;
+  // A port no process has left behind (a SIGKILLed one leaves its file).
+  for (int tries = 0; tries < 100 && (port.empty() || std::filesystem::exists(port)); ++tries) {
+    cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+    cfg.participant_id = 100 + static_cast<int>(random_instance() % 100);
+    port = "/dev/shm/fastrtps_port" +
+           std::to_string(rtps_unicast_port(cfg.domain_id, cfg.participant_id));
+  }
+  ASSERT_FALSE(std::filesystem::exists(port)) << "every port tried has a file: " << port;
   const auto no_handler = [](const msg::SwarmState&, const fdds::SampleInfo&) {};
   cfg.shm_transport = false;
   {

@@ -8,6 +8,7 @@
 //   fastrtps_<id> / fastrtps_port<N> (SHM transport): their "_el"/"_sl" lock
 //     file is not flock()ed by anyone (the owner holds it while alive) and
 //     no process maps the file (senders map a port whose owner died);
+//   fastrtps_port<N> without a lock file (its owner gone): no process maps it;
 //   fast_datasharing_<guid>_<entity> (data-sharing pools): no process maps it
 //     (/proc/*/maps).
 // Files in use by any live process, of any domain or user, are never touched.

@@ -100,6 +100,22 @@ TEST(ShmClean, KeepsADeadOwnersPortThatLiveSendersStillMap) {
   EXPECT_EQ(r.in_use, 1);
 }
 
+// A port whose owner has gone with its lock file, left because a sender
+// still counted on it: removed with its mutex once nobody maps it.
+TEST(ShmClean, RemovesAPortWithoutAnOwnerOrASender) {
+  TempDir d;
+  d.touch("fastrtps_port7415");
+  d.touch("sem.fastrtps_port7415_mutex", 32);
+  Mapping sent_to(d.touch("fastrtps_port7417"));  // a live sender still maps this one
+  ASSERT_TRUE(sent_to.ok());
+  auto r = clean_zombie_shm(d.path);
+  EXPECT_FALSE(d.has("fastrtps_port7415"));
+  EXPECT_FALSE(d.has("sem.fastrtps_port7415_mutex"));
+  EXPECT_TRUE(d.has("fastrtps_port7417"));
+  EXPECT_EQ(r.files_removed, 2);
+  EXPECT_EQ(r.in_use, 1);
+}
+
 // A server restarted after a SIGKILL must not come up on its dead
 // predecessor's ports, which the agents still map and write into.
 TEST(ShmClean, ParticipantIdClearOfPortsADeadProcessLeft) {
