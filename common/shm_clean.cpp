@@ -71,6 +71,12 @@ void remove(const std::string& dir, const std::string& name, ShmCleanReport& r) 
   }
 }
 
+/// A transport segment or port, and a port's mutex with it.
+void remove_segment(const std::string& dir, const std::string& name, ShmCleanReport& r) {
+  remove(dir, name, r);
+  if (starts_with(name, "fastrtps_port")) remove(dir, "sem." + name + "_mutex", r);
+}
+
 }  // namespace
 
 ShmCleanReport clean_zombie_shm(const std::string& dir) {
@@ -97,11 +103,10 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
         ++r.in_use;
         continue;
       }
-      remove(dir, base, r);
       remove(dir, n, r);
-      if (starts_with(base, "fastrtps_port")) remove(dir, "sem." + base + "_mutex", r);
-    } else if (starts_with(n, "fastrtps_port") && !ends_with(n, "_el") && !ends_with(n, "_sl") &&
-               !present.count(n + "_el") && !present.count(n + "_sl")) {
+      remove_segment(dir, base, r);
+    } else if (starts_with(n, "fastrtps_port") && !present.count(n + "_el") &&
+               !present.count(n + "_sl")) {
       // A port whose owner closed or died and took its lock file along: Fast
       // DDS 2.9 leaves the port itself while a sender still counted on it.
       // Nobody mapping it, nobody can use it (one file per SIGKILLed sender
@@ -110,8 +115,7 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
         ++r.in_use;
         continue;
       }
-      remove(dir, n, r);
-      remove(dir, "sem." + n + "_mutex", r);
+      remove_segment(dir, n, r);
     } else if (starts_with(n, "fast_datasharing_")) {
       if (is_mapped(n)) {
         ++r.in_use;

@@ -15,12 +15,17 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// A successful run of set, with a task time.
+bool succeeded_in(const RunRecord& r, const std::string& set) {
+  return r.set_name == set && r.ok && std::isfinite(r.task_time_s);
+}
+
 /// Successful runs' task times by seed, for one set.
 std::map<std::uint64_t, double> times_by_seed(const std::vector<RunRecord>& records,
                                               const std::string& set) {
   std::map<std::uint64_t, double> out;
   for (const auto& r : records)
-    if (r.set_name == set && r.ok && std::isfinite(r.task_time_s)) out[r.seed] = r.task_time_s;
+    if (succeeded_in(r, set)) out[r.seed] = r.task_time_s;
   return out;
 }
 
@@ -29,7 +34,7 @@ std::vector<double> successful_times(const std::vector<RunRecord>& records,
                                      const std::string& set) {
   std::vector<double> out;
   for (const auto& r : records)
-    if (r.set_name == set && r.ok && std::isfinite(r.task_time_s)) out.push_back(r.task_time_s);
+    if (succeeded_in(r, set)) out.push_back(r.task_time_s);
   return out;
 }
 
@@ -104,8 +109,7 @@ RankTest mann_whitney(const std::vector<double>& a, const std::vector<double>& b
   std::sort(pooled.begin(), pooled.end(),
             [](const auto& x, const auto& y) { return x.first < y.first; });
   const double total = static_cast<double>(m + n);
-  double rank_sum_a = 0, tie_term = 0;
-  bool ties = false;
+  double rank_sum_a = 0, tie_term = 0;  // tie_term: the sum of t^3 - t over groups of t ties
   for (std::size_t i = 0; i < pooled.size();) {
     std::size_t j = i;
     while (j < pooled.size() && pooled[j].first == pooled[i].first) ++j;
@@ -113,13 +117,12 @@ RankTest mann_whitney(const std::vector<double>& a, const std::vector<double>& b
     const double mean_rank = (static_cast<double>(i + 1) + static_cast<double>(j)) / 2;
     for (std::size_t k = i; k < j; ++k)
       if (pooled[k].second) rank_sum_a += mean_rank;
-    if (t > 1) ties = true;
     tie_term += t * t * t - t;
     i = j;
   }
   const double dm = static_cast<double>(m), dn = static_cast<double>(n);
   r.u = rank_sum_a - dm * (dm + 1) / 2;
-  if (!ties && m <= kExactRankTestMax && n <= kExactRankTestMax) {
+  if (tie_term == 0 && m <= kExactRankTestMax && n <= kExactRankTestMax) {
     // The distribution of U is symmetric about mn/2: P(U >= u) = P(U <= mn - u).
     const double lower = exact_u_cdf(m, n, std::min(r.u, dm * dn - r.u));
     r.p = std::min(1.0, 2 * lower);
