@@ -12,6 +12,8 @@
 #include <mutex>
 #include <random>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "common/config_error.hpp"
 
@@ -22,6 +24,16 @@ std::mutex g_mu;
 std::condition_variable g_cv;
 
 std::atomic<bool> g_rejoin{false};
+
+struct Wakers {
+  std::mutex mu;
+  std::uint64_t next = 0;
+  std::vector<std::pair<std::uint64_t, std::function<void()>>> wakes;
+};
+Wakers& wakers() {
+  static Wakers w;
+  return w;
+}
 
 extern "C" void on_signal(int) { g_stop.store(true); }
 extern "C" void on_rejoin_signal(int) { g_rejoin.store(true); }
@@ -118,6 +130,22 @@ bool stop_requested() { return g_stop.load(); }
 void request_stop() {
   g_stop.store(true);
   g_cv.notify_all();
+  auto& w = wakers();
+  std::lock_guard<std::mutex> lock(w.mu);
+  for (const auto& [id, wake] : w.wakes) wake();
+}
+
+StopWaker::StopWaker(std::function<void()> wake) {
+  auto& w = wakers();
+  std::lock_guard<std::mutex> lock(w.mu);
+  id_ = w.next++;
+  w.wakes.emplace_back(id_, std::move(wake));
+}
+
+StopWaker::~StopWaker() {
+  auto& w = wakers();
+  std::lock_guard<std::mutex> lock(w.mu);
+  std::erase_if(w.wakes, [this](const auto& e) { return e.first == id_; });
 }
 
 bool wait_for_stop(std::chrono::duration<double> d) {

@@ -1,6 +1,15 @@
 #include "common/process.hpp"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <mutex>
+#include <optional>
+#include <thread>
 
 namespace ddswarm {
 namespace {
@@ -28,6 +37,56 @@ TEST(RejoinPatience, DoublesAtEachTryUpToEightTimes) {
   EXPECT_EQ(rejoin_patience_s(20.0, 3), 160.0);
   EXPECT_EQ(rejoin_patience_s(20.0, 30), 160.0);  // no overflow, no endless growth
   EXPECT_EQ(rejoin_patience_s(10.0, -1), 10.0);
+}
+
+// A loop asleep on its own condition, for up to 30 s, as the agent's main
+// loop sleeps between its checks. Returns the seconds it slept.
+double sleep_until_stopped(std::mutex& mu, std::condition_variable& cv) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> lock(mu);
+  cv.wait_for(lock, std::chrono::seconds(30), [] { return stop_requested(); });
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A SIGTERM, taken by install_stop_signals' thread, wakes the sleeper at
+// once; exits 0 when it slept less than the 30 s it would without the waker.
+[[noreturn]] void signal_wakes_sleeper() {
+  install_stop_signals();
+  std::mutex mu;
+  std::condition_variable cv;
+  const StopWaker waker([&] {
+    { const std::lock_guard<std::mutex> lock(mu); }
+    cv.notify_all();
+  });
+  std::thread killer([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    kill(getpid(), SIGTERM);
+  });
+  const double slept = sleep_until_stopped(mu, cv);
+  killer.join();
+  std::exit(stop_requested() && slept < 20 ? 0 : 1);
+}
+
+// A waker destroyed before the stop is not called; a living one is, once.
+[[noreturn]] void only_living_wakers_called() {
+  int gone_calls = 0;
+  int living_calls = 0;
+  { const StopWaker gone([&] { ++gone_calls; }); }
+  std::optional<StopWaker> living;
+  living.emplace([&] { ++living_calls; });
+  request_stop();
+  living.reset();
+  request_stop();  // idempotent, and nobody is left to wake
+  std::exit(gone_calls == 0 && living_calls == 1 ? 0 : 1);
+}
+
+// A stop is sticky for the whole process, so each case runs in a child.
+TEST(StopWaker, ASignalWakesALoopAsleepOnItsOwnCondition) {
+  EXPECT_EXIT(signal_wakes_sleeper(), ::testing::ExitedWithCode(0), "");
+}
+
+TEST(StopWaker, OnlyTheLivingAreWoken) {
+  EXPECT_EXIT(only_living_wakers_called(), ::testing::ExitedWithCode(0), "");
 }
 
 }  // namespace
