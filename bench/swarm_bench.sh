@@ -250,6 +250,13 @@ field() {  # field KEY LINE
 # The cells every swarm table formats the same way, from a run_swarm line.
 up_cell() { field up_s "$1" | awk '{ printf "%.1f", $1 }'; }
 missed_cell() { field missed_frac "$1" | awk '{ if ($1 != "") printf "%.3f %%", 100 * $1; else print "-" }'; }
+# The share of the misses that fell in samples where half the swarm or more
+# missed at once (a machine-wide stall), and the kernel threads' CPU with the busiest.
+stall_cell() { field missed_in_stalls "$1" | awk '{ if ($1 != "") printf "%.0f %%", 100 * $1; else print "-" }'; }
+kernel_cell() {
+  local k top; k=$(field cpu_kernel "$1"); top=$(field cpu_kernel_top "$1")
+  if [ -n "$k" ]; then echo "$k (${top%:*} ${top##*:})"; else echo "-"; fi
+}
 note_cell() { echo "$1" | sed -n 's/.*why="\([^"]*\)".*/\1/p'; }
 
 # ---------------------------------------------------------------- lockstep
@@ -304,18 +311,18 @@ if ! skip realtime; then
   RUN_EXTRA=(); RUN_TOOL_ARGS=()
   echo
   echo "== real time: ${RT_TIME} s per N, $STREAMS state and commands, realtime_grace $RT_GRACE; criteria RTF >= 0.99, command age p99 <= 2 periods, missed < 0.1 % =="
-  echo "| N | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agents (each) | CPU discovery server | CPU probe | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | floor RTF (ticks/s / 50) | meets criteria | drone contacts | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| N | RTF | command age p50 / p99 / max (periods) | missed commands | of them in swarm-wide stalls | CPU sim | CPU agents (each) | CPU discovery server | CPU probe | CPU kernel threads (busiest) | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | floor RTF (ticks/s / 50) | meets criteria | drone contacts | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   best=0
   while read -r l; do
     n=$(field n "$l"); rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l"); mf=$(field missed_frac "$l")
     ok=$(echo "${rtf:-0} ${p99:-99} ${mf:-1}" | awk '{ print ($1 >= 0.99 && $2 <= 2 && $3 < 0.001) ? "yes" : "no" }')
     [ "$ok" = yes ] && [ "$n" -gt "$best" ] && best=$n
-    printf "| %s | %s | %s / %s / %s | %s (%s of %s) | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" \
+    printf "| %s | %s | %s / %s / %s | %s (%s of %s) | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n" \
       "$n" "${rtf:--}" "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
       "$(missed_cell "$l")" \
-      "$(field missed "$l")" "$(field drone_ticks "$l")" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
-      "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field cpu_probe "$l")" "$(field rss_agent_mb "$l")" \
+      "$(field missed "$l")" "$(field drone_ticks "$l")" "$(stall_cell "$l")" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
+      "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field cpu_probe "$l")" "$(kernel_cell "$l")" "$(field rss_agent_mb "$l")" \
       "$(field pss_agent_mb "$l")" "$(up_cell "$l")" \
       "$(field floor "$l" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')" "$ok" \
       "$(field contacts "$l")" "$(field load "$l")" "$(note_cell "$l")"

@@ -32,7 +32,25 @@ struct AgeStats {
   long samples = 0, probe_gaps = 0;
   std::uint64_t last_tick = 0;
   std::vector<std::int64_t> last_applied;            // per drone, -1 = unknown
+  std::vector<long> missed_by_drone;                 // per drone: are the misses a few drones' or everyone's?
+  long missed_in_stalls = 0;                         // misses seen in a sample where half the swarm or more missed
 };
+
+// "drones with a miss, and the share of all misses that the worst tenth of
+// the drones hold": a few starved or late-joined processes, or the whole swarm.
+std::string miss_spread(const std::vector<long>& by_drone) {
+  std::vector<long> v(by_drone);
+  std::sort(v.rbegin(), v.rend());
+  long total = 0, top = 0;
+  int with = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    total += v[i];
+    if (v[i] > 0) ++with;
+    if (i < std::max<std::size_t>(1, v.size() / 10)) top += v[i];
+  }
+  return fmt::format("missed_drones={} missed_top_tenth_share={:.3f}", with,
+                     total ? static_cast<double>(top) / total : 0.0);
+}
 
 double percentile(const std::vector<long>& hist, double q) {
   long total = 0;
@@ -85,6 +103,7 @@ int main(int argc, char** argv) {
     });
     AgeStats ag;
     ag.last_applied.assign(drones, -1);
+    ag.missed_by_drone.assign(drones, 0);
     std::atomic<bool> measuring{false};
     if (ages) {
       p.reader<msg::SwarmState>([&](const msg::SwarmState& s, const fdds::SampleInfo&) {
@@ -96,6 +115,8 @@ int main(int argc, char** argv) {
         if (ag.samples > 0 && s.tick() > ag.last_tick + 1) ag.probe_gaps += s.tick() - ag.last_tick - 1;
         ++ag.samples;
         ag.last_tick = s.tick();
+        long tick_missed = 0;
+        int tick_drones = 0, tick_missing = 0;
         for (const auto& d : s.drones()) {
           const int i = d.drone_id();
           if (i >= drones) continue;
@@ -109,12 +130,20 @@ int main(int argc, char** argv) {
           const long age = std::lround(d.command_age_s() / period);
           ++ag.hist[std::min<long>(age + 1, 63)];
           ++ag.drone_ticks;
+          ++tick_drones;
           const std::int64_t applied = static_cast<std::int64_t>(s.tick()) - 1 - age;
-          if (consecutive && ag.last_applied[i] >= 0 && applied > ag.last_applied[i] + 1)
+          if (consecutive && ag.last_applied[i] >= 0 && applied > ag.last_applied[i] + 1) {
             ag.missed += applied - ag.last_applied[i] - 1;
+            ag.missed_by_drone[i] += applied - ag.last_applied[i] - 1;
+            tick_missed += applied - ag.last_applied[i] - 1;
+            ++tick_missing;
+          }
           if (!consecutive) ag.last_applied[i] = -1;
           ag.last_applied[i] = std::max(ag.last_applied[i], applied);
         }
+        // A machine-wide stall (the kernel, another process) makes most of
+        // the swarm late at once; a starved agent misses alone.
+        if (tick_drones > 0 && 2 * tick_missing >= tick_drones) ag.missed_in_stalls += tick_missed;
       });
     }
     auto snapshot = [&] {
@@ -149,6 +178,10 @@ int main(int argc, char** argv) {
       procs.push_back(launcher);
     }
     procs.push_back(getpid());
+    // The kernel's own threads (children of kthreadd): a memory monitor such
+    // as DAMON's kdamond stalls a small VM in bursts (docs/performance.md).
+    const std::vector<pid_t> kthreads = descendants(2);
+    const auto k0 = sample_all(kthreads);
     msg::SimStatus s0 = next_status(0, snapshot().second.wall_time_s());
     auto cpu0 = sample_all(procs);
     const double w0 = wall_seconds();
@@ -157,6 +190,7 @@ int main(int argc, char** argv) {
     msg::SimStatus s1 = next_status(s0.tick(), s0.wall_time_s() + time_s * 0.9);
     measuring = false;
     auto cpu1 = sample_all(procs, true);
+    const auto k1 = sample_all(kthreads);
     const double dw = wall_seconds() - w0;
 
     const double server_dw = s1.wall_time_s() - s0.wall_time_s();
@@ -200,7 +234,20 @@ int main(int argc, char** argv) {
           percentile(ag.hist, 0.5), percentile(ag.hist, 0.99), percentile(ag.hist, 1.0), ag.missed, ag.drone_ticks,
           ag.drone_ticks ? static_cast<double>(ag.missed) / ag.drone_ticks : NAN, ag.samples, ag.probe_gaps,
           s1.failsafe(), s1.commands_applied() - s0.commands_applied(), s1.lockstep_timeouts());
+      line += " " + miss_spread(ag.missed_by_drone);
+      line += fmt::format(" missed_in_stalls={:.3f}",
+                          ag.missed ? static_cast<double>(ag.missed_in_stalls) / ag.missed : 0.0);
     }
+    double kernel = 0, kernel_top = 0;
+    std::string kernel_top_name = "-";
+    for (const auto& [pid, b] : k1) {
+      auto it = k0.find(pid);
+      if (it == k0.end()) continue;
+      const double c = (b.cpu_s - it->second.cpu_s) / dw;
+      kernel += c;
+      if (c > kernel_top) kernel_top = c, kernel_top_name = b.comm;
+    }
+    line += fmt::format(" cpu_kernel={:.3f} cpu_kernel_top={}:{:.3f}", kernel, kernel_top_name, kernel_top);
     std::printf("%s\n", line.c_str());
     p.close();
     return 0;
