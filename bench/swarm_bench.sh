@@ -344,12 +344,12 @@ if ! skip hosts; then
   rtf=$(field rtf "$l"); p99=$(field age_p99_periods "$l")
   echo
   echo "== agent hosts: $HOSTS_N drones (config/swarm_field.yaml) in $HOSTS_K ddswarm-agent --ids processes, real time, physics $HOSTS_PHYS Hz, sensors $HOSTS_SENS Hz, $STREAMS state and commands, realtime_grace $RT_GRACE, ${RT_TIME} s =="
-  echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | host RSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
-  printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
+  echo "| drones | agent processes | RTF | command age p50 / p99 / max (periods) | missed commands | CPU sim | CPU agent hosts (each) | CPU kernel threads (busiest) | host RSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  printf "| %s | %s | %s | %s / %s / %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s |\n" "$HOSTS_N" "$HOSTS_K" "${rtf:--}" \
     "$(field age_p50_periods "$l")" "${p99:--}" "$(field age_max_periods "$l")" \
     "$(missed_cell "$l")" \
-    "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" "$(field cpu_agent_each "$l")" "$(field rss_agent_mb "$l")" \
+    "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" "$(field cpu_agent_each "$l")" "$(kernel_cell "$l")" "$(field rss_agent_mb "$l")" \
     "$(up_cell "$l")" "$(field contacts "$l")" "$(field load "$l")" \
     "$(note_cell "$l")"
 fi

@@ -19,6 +19,9 @@ for v in plain pipelined hosts; do
   done
 done
 grep -Eq '^\| 3 \| [0-9.]+ \| [0-9]+ / [0-9]+ / [0-9]+ \|' "$out" || fail "real-time row for N=3 missing or empty"
+# ... with the share of misses in swarm-wide stalls and the kernel threads' CPU.
+grep -Eq '^\| 3 \| [0-9.]+ \| [0-9]+ / [0-9]+ / [0-9]+ \| [0-9.]+ % \([0-9]+ of [0-9]+\) \| [0-9]+ % \| [0-9.]+ \| [0-9.]+ \([0-9.]+\) \| [0-9.]+ \| [0-9.]+ \| [0-9.]+ \([^ ]+ [0-9.]+\) \|' "$out" ||
+  fail "real-time row for N=3 lacks the stall share or the kernel threads' CPU"
 grep -Eq '^\| task flight \| [0-9.]+ \|' "$out" || fail "Table 1 split missing"
 grep -q "4 runs, 0 failed" "$out" || fail "Table 1 quick runs failed"
 # Where the wake-ups go: each process's threads, woken and CPU per tick.
@@ -30,4 +33,6 @@ for who in sim agent; do
   sed -n "/^-- $who /,/^--/p" "$WORK/wakes.log" | grep -Eq '^\| [0-9]+ \| [0-9.]+ \| [0-9.]+ \| [0-9.]+ \|' ||
     fail "thread_wakes: no thread row for the $who"
 done
+grep -Eq '^all 3 agents, per agent and second of wall time: [0-9.]+ ms of CPU; main thread [0-9.]+ ms in [0-9.]+ runs' \
+  "$WORK/wakes.log" || fail "thread_wakes: no line for every agent"
 echo PASS
