@@ -379,13 +379,18 @@ struct SimServer::Impl {
       counters.rejected_impostor(counters.rejected_impostor() + 1);
       return;
     }
-    adopt(s, a.agent_instance(), a.drone_id());
+    const bool new_agent = adopt(s, a.agent_instance(), a.drone_id());
     if (std::isfinite(a.inter_distance_m()) && a.inter_distance_m() > 0)
       agent_d_int = std::max(agent_d_int, a.inter_distance_m());
-    cv.notify_all();
+    // Only a new agent changes what the main loop waits for (and its status
+    // goes out at once). Waking it for every heartbeat, 4 a second from each
+    // agent, woke it 0.7 extra times per tick at 64 drones in lockstep.
+    if (new_agent) cv.notify_all();
   }
 
-  void adopt(Slot& s, std::uint64_t instance, int id) {
+  /// Marks the slot heard; true when this made its agent live.
+  bool adopt(Slot& s, std::uint64_t instance, int id) {
+    const bool was_live = s.live;
     if (!s.live) {
       spdlog::info("drone {}: agent {:016x} online", id, instance);
       s.live = true;
@@ -396,6 +401,7 @@ struct SimServer::Impl {
       status_due = true;
     }
     s.last_heard_wall = wall_seconds();
+    return !was_live;
   }
 
   void on_mission(const msg::MissionCommand& m) {
