@@ -32,8 +32,10 @@ struct AgeStats {
   long samples = 0, probe_gaps = 0;
   std::uint64_t last_tick = 0;
   std::vector<std::int64_t> last_applied;            // per drone, -1 = unknown
-  std::vector<long> missed_by_drone;                 // per drone: are the misses a few drones' or everyone's?
-  long missed_in_stalls = 0;                         // misses seen in a sample where half the swarm or more missed
+  // Per drone: are the misses a few drones' or everyone's?
+  std::vector<long> missed_by_drone;
+  // Misses seen in a sample where half the swarm or more missed at once.
+  long missed_in_stalls = 0;
 };
 
 // "drones with a miss, and the share of all misses that the worst tenth of
@@ -247,7 +249,8 @@ int main(int argc, char** argv) {
       kernel += c;
       if (c > kernel_top) kernel_top = c, kernel_top_name = b.comm;
     }
-    line += fmt::format(" cpu_kernel={:.3f} cpu_kernel_top={}:{:.3f}", kernel, kernel_top_name, kernel_top);
+    line += fmt::format(" cpu_kernel={:.3f} cpu_kernel_top={}:{:.3f}", kernel, kernel_top_name,
+                        kernel_top);
     std::printf("%s\n", line.c_str());
     p.close();
     return 0;
