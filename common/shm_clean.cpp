@@ -71,7 +71,7 @@ void remove(const std::string& dir, const std::string& name, ShmCleanReport& r) 
   }
 }
 
-/// A transport segment or port, and a port's mutex with it.
+/// A transport segment, port or data-sharing pool, and a port's mutex with it.
 void remove_segment(const std::string& dir, const std::string& name, ShmCleanReport& r) {
   remove(dir, name, r);
   if (starts_with(name, "fastrtps_port")) remove(dir, "sem." + name + "_mutex", r);
@@ -105,23 +105,19 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
       }
       remove(dir, n, r);
       remove_segment(dir, base, r);
-    } else if (starts_with(n, "fastrtps_port") && !present.count(n + "_el") &&
-               !present.count(n + "_sl")) {
-      // A port whose owner closed or died and took its lock file along: Fast
-      // DDS 2.9 leaves the port itself while a sender still counted on it.
-      // Nobody mapping it, nobody can use it (one file per SIGKILLed sender
-      // piled up by the thousand in /dev/shm on a machine that ran the tests).
+    } else if ((starts_with(n, "fastrtps_port") && !present.count(n + "_el") &&
+                !present.count(n + "_sl")) ||
+               starts_with(n, "fast_datasharing_")) {
+      // No lock tells whether these are in use, only a mapping does. A port
+      // whose owner closed or died took its lock file along: Fast DDS 2.9
+      // leaves the port itself while a sender still counted on it (one file
+      // per SIGKILLed sender piled up by the thousand in /dev/shm on a
+      // machine that ran the tests). A data-sharing pool never has a lock.
       if (is_mapped(n)) {
         ++r.in_use;
         continue;
       }
       remove_segment(dir, n, r);
-    } else if (starts_with(n, "fast_datasharing_")) {
-      if (is_mapped(n)) {
-        ++r.in_use;
-        continue;
-      }
-      remove(dir, n, r);
     }
   }
   return r;

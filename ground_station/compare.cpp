@@ -57,6 +57,11 @@ double exact_u_cdf(std::size_t m, std::size_t n, double u) {
   return below / all;
 }
 
+/// A test's verdict at 5 % in the table: "n/a" when it could not be run.
+const char* verdict(bool tested, bool different) {
+  return !tested ? "n/a" : different ? "**DIFFERENT**" : "same";
+}
+
 std::string mean_sd(const SetSummary& s) {
   if (s.runs == 0) return "absent";
   const int ok = s.successes;
@@ -199,12 +204,12 @@ std::string comparison_table(const std::vector<SetComparison>& sets, const std::
     md << "| " << md_text(c.name) << " | " << mean_sd(c.base) << " | " << mean_sd(c.other) << " | "
        << or_na(c.mean_diff_s, "{:+.2f} s") << " | "
        << (tested ? fmt::format("{:+.2f} ({:.0f})", c.welch_t, c.welch_df) : "n/a") << " | "
-       << (tested ? (c.significant ? "**DIFFERENT**" : "same") : "n/a") << " | "
+       << verdict(tested, c.significant) << " | "
        << (std::isfinite(c.rank.p)
                ? fmt::format("{:.3g}{}", c.rank.p, c.rank.exact ? " (exact)" : "")
                : "n/a")
        << " | "
-       << (std::isfinite(c.rank.p) ? (c.rank.p < 0.05 ? "**DIFFERENT**" : "same") : "n/a")
+       << verdict(std::isfinite(c.rank.p), c.rank.p < 0.05)
        << " | "
        << (c.paired_runs ? fmt::format("{:.2f} ({:.2f}) s, {} runs", c.paired_mean_abs_s,
                                        c.paired_max_abs_s, c.paired_runs)
