@@ -197,10 +197,17 @@ struct AgentApp::Impl {
                            : "agent host (" + std::to_string(ids.size()) + " drones)";
   }
 
+  /// The agent's shared-memory outbox is sized for the drones it flies.
+  static DdsConfig dds_for(const AgentAppConfig& c) {
+    DdsConfig d = c.dds;
+    d.shm_segment_bytes = agent_shm_segment_bytes(c.drone_ids.size());
+    return d;
+  }
+
   explicit Impl(AgentAppConfig c)
       : cfg(std::move(c)),
         label(label_for(cfg.drone_ids)),
-        dds(cfg.dds, cfg.drone_ids.size() == 1 ? "ddswarm-agent-" + std::to_string(cfg.drone_ids[0])
+        dds(dds_for(cfg), cfg.drone_ids.size() == 1 ? "ddswarm-agent-" + std::to_string(cfg.drone_ids[0])
                                                : "ddswarm-agent-host"),
         // Under DDS Security only agent-K may publish in drone K's partition
         // (one drone per secure agent process: docs/security.md).

@@ -1,6 +1,7 @@
 #include "common/dds_config.hpp"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <arpa/inet.h>
 
 #include <cstdio>
@@ -53,6 +54,11 @@ void load(YamlSection s, DdsConfig& c) {
 
 int rtps_unicast_port(int domain_id, int participant_id) { return 7400 + 250 * domain_id + 10 + 2 * participant_id; }
 int max_participant_id(int domain_id) { return (65535 - 1 - rtps_unicast_port(domain_id, 0)) / 2; }
+
+std::uint32_t agent_shm_segment_bytes(std::size_t drones) {
+  const std::size_t bytes = (256u << 10) + drones * (16u << 10);
+  return static_cast<std::uint32_t>(std::min<std::size_t>(bytes, kShmSegmentBytes));
+}
 
 void DdsConfig::validate() const {
   if (FILE* f = std::fopen(profiles_file.c_str(), "r")) {

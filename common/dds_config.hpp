@@ -4,6 +4,8 @@
 // The default reaches nothing but this machine: shared memory plus UDPv4
 // bound to 127.0.0.1. Other hosts are reached only when the user names an
 // interface, a list of peers, or a discovery server (docs/networking.md).
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,22 @@ int max_participant_id(int domain_id);
 /// on it.
 constexpr double kDiscoveryServerLeaseS = 20.0;
 
+/// The shared-memory transport's segment of every process but an agent: its
+/// outbox, where each sample it sends by that transport waits until every
+/// local reader has taken it. The server's whole-swarm state for a recorder
+/// reading by the transport is up to about 300 KB at 1,024 drones.
+constexpr std::uint32_t kShmSegmentBytes = 4u << 20;
+
+/// An agent process's segment: 256 KiB, plus 16 KiB for each drone it flies,
+/// at most kShmSegmentBytes. A drone's agent sends about 300 bytes a tick
+/// (its command and beacon) and a heartbeat 4 times a second: 256 KiB holds
+/// some 800 ticks of one drone's samples, and each drone's 16 KiB another 50,
+/// so an agent host of 240 drones or more keeps the whole 4 MiB. Fast DDS
+/// fills the segment as it makes it, so every byte stays resident: at 4 MiB,
+/// 128 agent processes held 540 MB of /dev/shm, most of it never written
+/// (docs/performance.md).
+std::uint32_t agent_shm_segment_bytes(std::size_t drones);
+
 struct DdsConfig {
   int domain_id = 0;                  ///< DDS domain, [0, 232]
   Discovery discovery = Discovery::kLocalhost;
@@ -52,6 +70,9 @@ struct DdsConfig {
   /// sample (velocity commands, statuses, missions) over UDP on 127.0.0.1;
   /// 128 real-time agents then missed fewer commands (docs/performance.md).
   bool shm_transport = true;
+  /// Bytes of the shared-memory transport's segment (this process's outbox);
+  /// set by the binary for what it is, not read from YAML.
+  std::uint32_t shm_segment_bytes = kShmSegmentBytes;
   int participant_id = -1;            ///< RTPS participant id, -1 = automatic; set explicitly past ~100 participants per host
                                       ///< (at most max_participant_id(domain_id): the RTPS ports must fit)
   double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement

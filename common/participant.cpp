@@ -158,7 +158,7 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
 
   if (uses_shm_transport(cfg)) {
     auto shm = std::make_shared<SharedMemTransportDescriptor>();
-    shm->segment_size(4 * 1024 * 1024);
+    shm->segment_size(cfg.shm_segment_bytes);
     qos.transport().user_transports.push_back(shm);
   }
   qos.transport().user_transports.push_back(udp);
