@@ -18,6 +18,7 @@
 
 #include "common/participant.hpp"
 #include "common/process.hpp"
+#include "common/shm_clean.hpp"
 
 namespace ddswarm {
 namespace {
@@ -220,15 +221,17 @@ TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
 // /dev/shm named by the RTPS port: every other sample then goes over UDP.
 TEST(Participant, WithoutTheShmTransportTheSwarmStateStillComesByDataSharing) {
   DdsConfig cfg;
-  std::filesystem::path port;
-  // A port no process has left behind (a SIGKILLed one leaves its file).
-  for (int tries = 0; tries < 100 && (port.empty() || std::filesystem::exists(port)); ++tries) {
+  // Ids of 100 and up, clear of any port file a process left behind (a
+  // SIGKILLed one leaves its file) and away from automatic ids.
+  cfg.participant_id = -1;
+  for (int tries = 0; tries < 10 && cfg.participant_id < 0; ++tries) {
     cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
-    cfg.participant_id = 100 + static_cast<int>(random_instance() % 100);
-    port = "/dev/shm/fastrtps_port" +
-           std::to_string(rtps_unicast_port(cfg.domain_id, cfg.participant_id));
+    cfg.participant_id = participant_id_clear_of_shm(
+        cfg.domain_id, 199, "/dev/shm", 100 + static_cast<int>(random_instance() % 100));
   }
-  ASSERT_FALSE(std::filesystem::exists(port)) << "every port tried has a file: " << port;
+  ASSERT_GE(cfg.participant_id, 0) << "every id tried has a port file";
+  const std::filesystem::path port =
+      "/dev/shm/fastrtps_port" + std::to_string(rtps_unicast_port(cfg.domain_id, cfg.participant_id));
   const auto no_handler = [](const msg::SwarmState&, const fdds::SampleInfo&) {};
   cfg.shm_transport = false;
   {

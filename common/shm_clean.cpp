@@ -123,12 +123,12 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
   return r;
 }
 
-int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir) {
+int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir, int first_id) {
   auto held = [&](int port) {
     struct stat st;
     return stat((dir + "/fastrtps_port" + std::to_string(port)).c_str(), &st) == 0;
   };
-  for (int id = 0; id <= max_id; ++id) {
+  for (int id = first_id; id <= max_id; ++id) {
     const int meta = rtps_unicast_port(domain_id, id);
     if (!held(meta) && !held(meta + 1)) return id;
   }

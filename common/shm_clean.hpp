@@ -26,13 +26,14 @@ struct ShmCleanReport {
 /// Cleans dir (default /dev/shm). Never throws; unreadable entries are skipped.
 ShmCleanReport clean_zombie_shm(const std::string& dir = "/dev/shm");
 
-/// The lowest participant id in [0, max_id] whose two RTPS unicast ports in
+/// The lowest participant id in [first_id, max_id] whose two RTPS unicast ports in
 /// domain_id (metatraffic and user data) have no shared-memory port file in
 /// dir, or -1 when every one has. A port file left by a process that died
 /// (a killed server) is still mapped by the processes that sent to it, and
 /// Fast DDS 2.9 keeps them writing into it after a new process re-creates the
 /// port under the same name: nothing they send reaches the newcomer
 /// (docs/dds.md). A newcomer on a clear id gets ports nobody holds.
-int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir = "/dev/shm");
+int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir = "/dev/shm",
+                                int first_id = 0);
 
 }  // namespace ddswarm

@@ -132,4 +132,7 @@ TEST(ShmClean, ParticipantIdClearOfPortsADeadProcessLeft) {
   d.touch("fastrtps_" + std::to_string(rtps_unicast_port(domain, 2)));
   EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path), 2);
   EXPECT_EQ(participant_id_clear_of_shm(domain, 1, d.path), -1);  // every id up to max_id is held
+  // From a first id on: 1 is held, 2 is clear.
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path, 1), 2);
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path, 3), 3);
 }
