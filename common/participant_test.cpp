@@ -230,8 +230,8 @@ TEST(Participant, WithoutTheShmTransportTheSwarmStateStillComesByDataSharing) {
         cfg.domain_id, 199, "/dev/shm", 100 + static_cast<int>(random_instance() % 100));
   }
   ASSERT_GE(cfg.participant_id, 0) << "every id tried has a port file";
-  const std::filesystem::path port =
-      "/dev/shm/fastrtps_port" + std::to_string(rtps_unicast_port(cfg.domain_id, cfg.participant_id));
+  const int port_number = rtps_unicast_port(cfg.domain_id, cfg.participant_id);
+  const std::filesystem::path port = "/dev/shm/fastrtps_port" + std::to_string(port_number);
   const auto no_handler = [](const msg::SwarmState&, const fdds::SampleInfo&) {};
   cfg.shm_transport = false;
   {
