@@ -207,8 +207,9 @@ struct AgentApp::Impl {
   explicit Impl(AgentAppConfig c)
       : cfg(std::move(c)),
         label(label_for(cfg.drone_ids)),
-        dds(dds_for(cfg), cfg.drone_ids.size() == 1 ? "ddswarm-agent-" + std::to_string(cfg.drone_ids[0])
-                                               : "ddswarm-agent-host"),
+        dds(dds_for(cfg), cfg.drone_ids.size() == 1
+                              ? "ddswarm-agent-" + std::to_string(cfg.drone_ids[0])
+                              : "ddswarm-agent-host"),
         // Under DDS Security only agent-K may publish in drone K's partition
         // (one drone per secure agent process: docs/security.md).
         w_cmd(dds.writer<msg::VelocityCommand>(
