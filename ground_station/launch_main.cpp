@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
       dds_args.push_back(std::string("--best-effort-streams=") + (dds_cli.best_effort_streams ? "true" : "false"));
     const std::string bin = Launcher::self_dir();
     install_stop_signals();
-    const bool stop_on_death = on_death != "keep";
+    DeathPolicy death_policy(parse_on_death(on_death));
     Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
     const bool localhost_discovery = file.dds.discovery == Discovery::kLocalhost &&
                                      !app.count("--dds-interface") && !app.count("--dds-peers");
@@ -251,10 +251,9 @@ int main(int argc, char** argv) {
     };
     // Agent hosts: K processes, each flying a contiguous share of the ids.
     const auto shares = agent_host_shares(ids, agent_hosts);
-    std::map<std::string, ChildSpec> agents;  // by name: what --on-death restart starts again
-    const auto start_agent = [&](ChildSpec spec) {
+    const auto start_agent = [&](const ChildSpec& spec) {
       procs.start(spec);
-      agents[spec.name] = std::move(spec);
+      death_policy.restartable(spec);  // what --on-death restart may start again
     };
     for (std::size_t h = 0; h < shares.size(); ++h)
       start_agent({"agent host " + std::to_string(h), agent_args(shares[h], true)});
@@ -269,23 +268,17 @@ int main(int argc, char** argv) {
     std::cerr << fmt::format("ddswarm-launch: started {} process(es); policy on death: {}\n",
                              procs.running(), on_death);
     int rc = 0;
-    bool died = false;  // a process died and was not started again
-    std::map<std::string, int> restarts;
     // Reaps the children that ended, applies --on-death, and says whether to stop.
     const auto deaths = [&] {
       for (const auto& e : procs.reap()) {
         std::cerr << "ddswarm-launch: " << e.describe() << "\n";
-        const auto spec = agents.find(e.name);
-        if (on_death == "restart" && spec != agents.end() && worth_restarting(e) &&
-            restarts[e.name] < kMaxRestarts) {
+        if (const auto again = death_policy.ended(e)) {
           std::cerr << fmt::format("ddswarm-launch: restarting {} ({} of {})\n", e.name,
-                                   ++restarts[e.name], kMaxRestarts);
-          procs.start(spec->second);
-          continue;
+                                   death_policy.restarts(e.name), kMaxRestarts);
+          procs.start(*again);
         }
-        died = true;
       }
-      return died && stop_on_death;
+      return death_policy.stop();
     };
     auto gs_argv = [&](const std::vector<std::string>& sub) {
       std::vector<std::string> a = {bin + "/ddswarm-gs", "--config", scenario};
@@ -297,7 +290,7 @@ int main(int argc, char** argv) {
       std::vector<std::string> steps = {"wait-agents --count " + std::to_string(ids.empty() ? 0 : static_cast<int>(ids.size()))};
       for (const auto& s : split_script(gs_script)) steps.push_back(s);
       for (const auto& step : steps) {
-        if (stop_requested() || (died && stop_on_death)) break;
+        if (stop_requested() || death_policy.stop()) break;
         std::cerr << "ddswarm-launch: gs " << step << "\n";
         rc = run_foreground(gs_argv(words(step)), procs, deaths);
         if (rc != 0) {
@@ -314,13 +307,13 @@ int main(int argc, char** argv) {
         wait_for_stop(std::chrono::milliseconds(100));
       }
     }
-    if (died && stop_on_death) std::cerr << "ddswarm-launch: a process died; stopping everything\n";
+    if (death_policy.stop()) std::cerr << "ddswarm-launch: a process died; stopping everything\n";
     // A clean shutdown is exit code 0 after our SIGTERM; anything else is worth saying.
     for (const auto& e : procs.stop_all(3.0))
       if ((e.signal != 0 && e.signal != SIGTERM) || (e.signal == 0 && e.exit_code != 0))
         std::cerr << "ddswarm-launch: at shutdown " << e.describe() << "\n";
     std::cerr << "ddswarm-launch: all processes stopped\n";
     if (rc != 0) return 1;
-    return died && stop_on_death ? 1 : 0;
+    return death_policy.stop() ? 1 : 0;
   });
 }

@@ -370,6 +370,29 @@ bool worth_restarting(const ChildExit& e) {
   return e.exit_code != 0 && e.exit_code != 2 && e.exit_code != 3;
 }
 
+OnDeath parse_on_death(const std::string& text) {
+  if (text == "stop") return OnDeath::kStop;
+  if (text == "keep") return OnDeath::kKeep;
+  if (text == "restart") return OnDeath::kRestart;
+  throw std::invalid_argument("--on-death = " + text + ": must be stop, keep or restart");
+}
+
+std::optional<ChildSpec> DeathPolicy::ended(const ChildExit& e) {
+  const auto spec = restartable_.find(e.name);
+  if (policy_ == OnDeath::kRestart && spec != restartable_.end() && worth_restarting(e) &&
+      restarts_[e.name] < kMaxRestarts) {
+    ++restarts_[e.name];
+    return spec->second;
+  }
+  died_ = true;
+  return std::nullopt;
+}
+
+int DeathPolicy::restarts(const std::string& name) const {
+  const auto it = restarts_.find(name);
+  return it == restarts_.end() ? 0 : it->second;
+}
+
 std::vector<std::string> agent_command(const std::string& bin, const std::string& ids, bool host,
                                        const std::string& scenario, bool started_with_server) {
   std::vector<std::string> a = {bin + "/ddswarm-agent", host ? "--ids" : "--id", ids, "--config",

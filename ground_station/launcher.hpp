@@ -43,6 +43,38 @@ bool worth_restarting(const ChildExit& e);
 /// How many times --on-death restart starts one agent again.
 constexpr int kMaxRestarts = 3;
 
+/// --on-death: what the launcher does when one of its processes ends.
+/// kStop: stop everything. kKeep: report it and keep flying. kRestart: start
+/// a restartable process (an agent) again when worth_restarting says it can
+/// mend, up to kMaxRestarts times each; any other end stops everything.
+enum class OnDeath { kStop, kKeep, kRestart };
+/// "stop", "keep" or "restart"; throws std::invalid_argument naming the value.
+OnDeath parse_on_death(const std::string& text);
+
+/// The bookkeeping of --on-death, with no processes in it: the launcher
+/// reports each child that ended, and is told what to start again and
+/// whether to stop.
+class DeathPolicy {
+ public:
+  explicit DeathPolicy(OnDeath policy) : policy_(policy) {}
+  /// A process that kRestart may start again (the launcher's agents).
+  void restartable(const ChildSpec& spec) { restartable_[spec.name] = spec; }
+  /// A child ended: the spec to start again, or nothing (it died).
+  std::optional<ChildSpec> ended(const ChildExit& e);
+  /// Some child ended and was not started again.
+  bool died() const { return died_; }
+  /// The launcher should stop everything: a death, unless kKeep.
+  bool stop() const { return died_ && policy_ != OnDeath::kKeep; }
+  /// How many times the child of that name was started again.
+  int restarts(const std::string& name) const;
+
+ private:
+  OnDeath policy_;
+  std::map<std::string, ChildSpec> restartable_;
+  std::map<std::string, int> restarts_;
+  bool died_ = false;
+};
+
 /// Runs spec to its end and returns how it ended; output gets its stdout and
 /// stderr together. For quick checks (`ddswarm-sim --check`): no timeout, no
 /// supervision. Throws std::runtime_error when it cannot start.

@@ -165,6 +165,65 @@ TEST(Launcher, RestartsOnlyWhatStartingAgainCanMend) {
   EXPECT_FALSE(worth_restarting(exit_with(3)));  // another agent flies its drone
 }
 
+// --on-death restart: a crashed agent flies again up to kMaxRestarts times;
+// its next crash, or any end of a process that is no agent, stops everything.
+TEST(DeathPolicy, RestartsACrashedAgentThreeTimesThenStops) {
+  DeathPolicy p(OnDeath::kRestart);
+  const ChildSpec agent{"agent 2", {"b/ddswarm-agent", "--id", "2"}};
+  p.restartable(agent);
+  const ChildExit crash{"agent 2", 42, -1, SIGABRT};
+  for (int k = 1; k <= kMaxRestarts; ++k) {
+    const auto again = p.ended(crash);
+    ASSERT_TRUE(again.has_value()) << "restart " << k;
+    EXPECT_EQ(again->argv, agent.argv);
+    EXPECT_EQ(p.restarts("agent 2"), k);
+    EXPECT_FALSE(p.stop());
+  }
+  EXPECT_FALSE(p.ended(crash).has_value());
+  EXPECT_TRUE(p.died());
+  EXPECT_TRUE(p.stop());
+}
+
+TEST(DeathPolicy, RestartsNeitherTheServerNorAnAgentThatWouldFailAgain) {
+  DeathPolicy server_died(OnDeath::kRestart);
+  server_died.restartable({"agent 0", {"b/ddswarm-agent"}});
+  EXPECT_FALSE(server_died.ended({"sim", 7, -1, SIGSEGV}).has_value());
+  EXPECT_TRUE(server_died.stop());
+
+  DeathPolicy bad_config(OnDeath::kRestart);
+  bad_config.restartable({"agent 0", {"b/ddswarm-agent"}});
+  EXPECT_FALSE(bad_config.ended({"agent 0", 8, 2, 0}).has_value());  // exit 2: its configuration
+  EXPECT_TRUE(bad_config.stop());
+  EXPECT_EQ(bad_config.restarts("agent 0"), 0);
+}
+
+TEST(DeathPolicy, StopStopsAtTheFirstDeathAndKeepNever) {
+  DeathPolicy stop(OnDeath::kStop);
+  stop.restartable({"agent 0", {"b/ddswarm-agent"}});
+  EXPECT_FALSE(stop.stop());
+  EXPECT_FALSE(stop.ended({"agent 0", 9, -1, SIGKILL}).has_value());
+  EXPECT_TRUE(stop.stop());
+
+  DeathPolicy keep(OnDeath::kKeep);
+  keep.restartable({"agent 0", {"b/ddswarm-agent"}});
+  EXPECT_FALSE(keep.ended({"agent 0", 9, -1, SIGKILL}).has_value());
+  EXPECT_FALSE(keep.ended({"sim", 10, 1, 0}).has_value());
+  EXPECT_TRUE(keep.died());
+  EXPECT_FALSE(keep.stop());
+}
+
+TEST(DeathPolicy, ParsesTheOptionAndNamesABadValue) {
+  EXPECT_EQ(parse_on_death("stop"), OnDeath::kStop);
+  EXPECT_EQ(parse_on_death("keep"), OnDeath::kKeep);
+  EXPECT_EQ(parse_on_death("restart"), OnDeath::kRestart);
+  try {
+    parse_on_death("resurrect");
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--on-death = resurrect"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Launcher, MissingProgramIsAClearError) {
   Launcher l;
   try {
