@@ -44,8 +44,8 @@ constexpr double kDiscoveryServerLeaseS = 20.0;
 
 /// The shared-memory transport's segment of every process but an agent: its
 /// outbox, where each sample it sends by that transport waits until every
-/// local reader has taken it. The server's whole-swarm state for a recorder
-/// reading by the transport is up to about 300 KB at 1,024 drones.
+/// local reader has taken it. The server's whole-swarm state, which a
+/// recorder reads by the transport, is a few hundred KB at 1,024 drones.
 constexpr std::uint32_t kShmSegmentBytes = 4u << 20;
 
 /// An agent process's segment: 256 KiB, plus 16 KiB for each drone it flies,
@@ -54,7 +54,7 @@ constexpr std::uint32_t kShmSegmentBytes = 4u << 20;
 /// some 800 ticks of one drone's samples, and each drone's 16 KiB another 50,
 /// so an agent host of 240 drones or more keeps the whole 4 MiB. Fast DDS
 /// fills the segment as it makes it, so every byte stays resident: at 4 MiB,
-/// 128 agent processes held 540 MB of /dev/shm, most of it never written
+/// 128 agent processes held 538 MB of /dev/shm, most of it never written
 /// (docs/performance.md).
 std::uint32_t agent_shm_segment_bytes(std::size_t drones);
 
