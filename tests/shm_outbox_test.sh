@@ -13,7 +13,8 @@ own_segment() {
   for el in /dev/shm/fastrtps_[0-9a-f]*_el; do
     [ -e "$el" ] || continue
     ino=$(stat -c %i "$el" 2>/dev/null) || continue
-    if awk -v p="$1" -v i="$ino" '$5 == p && $6 ~ (":" i "$") { f = 1 } END { exit !f }' /proc/locks; then
+    if awk -v p="$1" -v i="$ino" '$5 == p && $6 ~ (":" i "$") { f = 1 } END { exit !f }' \
+      /proc/locks; then
       stat -c %s "${el%_el}"
       return 0
     fi
@@ -29,24 +30,29 @@ sim=$(pgrep -P "$PID_launch" -x ddswarm-sim) || fail "no server under the launch
 agents=$(pgrep -P "$PID_launch" -x ddswarm-agent) || fail "no agents under the launcher"
 [ "$(echo "$agents" | wc -w)" -eq 6 ] || fail "expected 6 agent processes: $agents"
 size=$(own_segment "$sim") || fail "the server (pid $sim) holds no shared-memory segment"
-within "$size" $(( 4096 * 1024 )) || fail "the server's segment is $(kib "$size") KiB, expected 4 MiB"
+within "$size" $(( 4096 * 1024 )) ||
+  fail "the server's segment is $(kib "$size") KiB, expected 4 MiB"
 total=$size
 for p in $agents; do
   size=$(own_segment "$p") || fail "agent pid $p holds no shared-memory segment"
-  within "$size" $(( 272 * 1024 )) || fail "agent pid $p's segment is $(kib "$size") KiB, expected 272 KiB"
+  within "$size" $(( 272 * 1024 )) ||
+    fail "agent pid $p's segment is $(kib "$size") KiB, expected 272 KiB"
   total=$(( total + size ))
 done
 probe_swarm 6
 echo "the server and 6 agents hold $(( total / 1024 )) KiB of transport segments (7 x 4 MiB before);" \
   "rtf $(probe_val rtf), command age p99 $(probe_val age_p99_periods) periods, missed $(probe_val missed)"
-[ "$(probe_val age_p99_periods)" -le 2 ] || fail "command age p99 $(probe_val age_p99_periods) periods"
-awk -v m="$(probe_val missed_frac)" 'BEGIN { exit !(m < 0.01) }' || fail "missed $(probe_val missed_frac) of commands"
+[ "$(probe_val age_p99_periods)" -le 2 ] ||
+  fail "command age p99 $(probe_val age_p99_periods) periods"
+awk -v m="$(probe_val missed_frac)" 'BEGIN { exit !(m < 0.01) }' ||
+  fail "missed $(probe_val missed_frac) of commands"
 gs land --wait || fail "land"
 
 # An agent host of six drones asks for 256 + 6 x 16 KiB as it starts.
 start host "$BIN/ddswarm-agent" --ids 0-5 --config "$scenario" --domain $(( DOMAIN + 1 ))
 for _ in $(seq 100); do size=$(own_segment "$PID_host") && break; sleep 0.1; done
 [ -n "${size:-}" ] || fail "the agent host holds no shared-memory segment after 10 s"
-within "$size" $(( 352 * 1024 )) || fail "the agent host's segment is $(kib "$size") KiB, expected 352 KiB"
+within "$size" $(( 352 * 1024 )) ||
+  fail "the agent host's segment is $(kib "$size") KiB, expected 352 KiB"
 echo "an agent host of 6 drones holds $(kib "$size") KiB"
 echo PASS
