@@ -3,15 +3,21 @@
 
 namespace ddswarm::sim {
 
-/// While no live agent at all has been heard within agent_timeout_s, an agent
-/// is declared lost only after this many timeouts.
+/// While no live agent at all has been heard for this share of
+/// agent_timeout_s, an agent is declared lost only after kSilentSwarmTimeouts
+/// timeouts. Every live agent sends a heartbeat 4 times a second.
+constexpr double kSilentSwarmShare = 0.5;
 constexpr double kSilentSwarmTimeouts = 3.0;
 
 /// How long (wall s) a live agent may stay silent before the server declares
 /// it lost: agent_timeout_s, or kSilentSwarmTimeouts times that while every
-/// live agent is silent, since then the silence may be the server's own (Fast
-/// DDS stalled its receive threads for over a second while it dropped a killed
-/// agent's participant, and every other agent was declared lost with it).
+/// live agent has been silent for kSilentSwarmShare of it, since then the
+/// silence may be the server's own. Fast DDS stalled its receive threads for
+/// over a second while it dropped a killed agent's participant, and every
+/// other agent was declared lost with it. An agent SIGKILLed while it held the
+/// server's shared-memory port lock stalls them for Fast DDS's 1 s lock
+/// timeout: the agent heard longest ago, 1 s before, was declared lost too,
+/// though the others had been silent for only 0.7 s (mp_fault_agent_kill).
 /// newest_heard_s: when any live agent was last heard.
 double agent_silence_limit(double now_s, double newest_heard_s, double agent_timeout_s);
 

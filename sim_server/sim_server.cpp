@@ -132,7 +132,7 @@ struct SimServer::Impl {
   std::atomic<std::uint64_t> rival_instance{0};
   bool rival_logged = false;
   std::int64_t scene_published_ns = 0;  // system clock, as the scene's source timestamp
-  bool swarm_silent = false;  // expire_agents: no live agent heard within agent_timeout_s
+  bool swarm_silent = false;  // expire_agents: no live agent heard lately (agent_silence_limit)
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   // What a ground station waits for changed since the last SimStatus: an
