@@ -14,10 +14,10 @@ constexpr double kSilentSwarmTimeouts = 3.0;
 /// live agent has been silent for kSilentSwarmShare of it, since then the
 /// silence may be the server's own. Fast DDS stalled its receive threads for
 /// over a second while it dropped a killed agent's participant, and every
-/// other agent was declared lost with it. An agent SIGKILLed while it held the
-/// server's shared-memory port lock stalls them for Fast DDS's 1 s lock
-/// timeout: the agent heard longest ago, 1 s before, was declared lost too,
-/// though the others had been silent for only 0.7 s (mp_fault_agent_kill).
+/// other agent was declared lost with it. Once, in mp_fault_agent_kill, the
+/// agent heard longest ago, 1 s before, was declared lost with the killed one
+/// and was back 9 ms later (likely the killed agent held the server's
+/// shared-memory port lock, which Fast DDS waits 1 s for; docs/faults.md).
 /// newest_heard_s: when any live agent was last heard.
 double agent_silence_limit(double now_s, double newest_heard_s, double agent_timeout_s);
 
