@@ -60,6 +60,8 @@ std::uint32_t agent_shm_segment_bytes(std::size_t drones) {
   return static_cast<std::uint32_t>(std::min<std::size_t>(bytes, kShmSegmentBytes));
 }
 
+double one_shot_lease_s(double configured_s) { return std::max(configured_s, kOneShotLeaseS); }
+
 void DdsConfig::validate() const {
   if (FILE* f = std::fopen(profiles_file.c_str(), "r")) {
     std::fclose(f);

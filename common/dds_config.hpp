@@ -42,6 +42,20 @@ int max_participant_id(int domain_id);
 /// on it.
 constexpr double kDiscoveryServerLeaseS = 20.0;
 
+/// The least lease a one-shot ground-station command announces (every
+/// ddswarm-gs subcommand but the console). Each peer checks a participant's
+/// lease on a timer that first fires one announced lease after discovering
+/// it. In Debian's Fast DDS 2.9.1, a participant that says goodbye just as
+/// that timer fires aborts the peer (PDP.cpp:1140, "GUID_t::unknown() !=
+/// remote_participant->m_guid"): 90 `status` processes of about 3 s each,
+/// against a 3 s lease, aborted 4 agents of 32 once. A command that leaves
+/// before its lease has passed is never checked, so never races.
+constexpr double kOneShotLeaseS = 20.0;
+
+/// The lease a one-shot command announces: the configured one, or
+/// kOneShotLeaseS if that is longer.
+double one_shot_lease_s(double configured_s);
+
 /// The shared-memory transport's segment of every process but an agent: its
 /// outbox, where each sample it sends by that transport waits until every
 /// local reader has taken it. The server's whole-swarm state, which a

@@ -68,6 +68,16 @@ TEST_F(SecureDir, BadOrMissingRoleRejected) {
   EXPECT_THROW(secure("../agent-2").validate(), FieldError);
 }
 
+TEST(OneShotLease, ACommandThatComesAndGoesOutlivesNoPeersLeaseTimer) {
+  // At the default 3 s lease a `status` of about 3 s left as its peers'
+  // timers fired; a longer configured lease is kept, and both stay valid.
+  EXPECT_EQ(one_shot_lease_s(DdsConfig{}.lease_duration_s), kOneShotLeaseS);
+  EXPECT_EQ(one_shot_lease_s(60.0), 60.0);
+  DdsConfig c;
+  c.lease_duration_s = one_shot_lease_s(c.lease_duration_s);
+  EXPECT_NO_THROW(c.validate());
+}
+
 TEST(DdsConfigSecurity, DefaultRoleKeepsTheUsersChoice) {
   DdsConfig c;
   default_security_role(c, "server");
