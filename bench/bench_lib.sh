@@ -19,17 +19,18 @@ bench_scenario() {
     { echo "$(basename "$0"): cannot derive $1" >&2; exit 2; }
 }
 
-# bench_hold_swarm MODE N DIR SCENARIO: starts ddswarm-launch (N agent
-# processes, MODE lockstep|realtime, logs in DIR) in the background, waits for
-# every agent, takes off and holds. Sets LAUNCH_PID and GS (the ground-station
+# bench_hold_swarm MODE N DIR SCENARIO [LAUNCH_ARGS...]: starts ddswarm-launch
+# (N agent processes, MODE lockstep|realtime, logs in DIR, LAUNCH_ARGS added)
+# in the background for up to 900 s, waits for every agent, takes off and holds. Sets LAUNCH_PID and GS (the ground-station
 # command line for this swarm); returns 1 with a message when the swarm did
 # not come up. bench_stop_launch stops it by PID.
 LAUNCH_PID=""
 bench_hold_swarm() {
   local mode="$1" n="$2" dir="$3" scenario="$4" dom addr
+  shift 4
   dom=$(bench_domain)
   "$BIN/ddswarm-launch" "$scenario" --drones "$n" --mode "$mode" --domain "$dom" --log-dir "$dir" \
-    --discovery-server auto --duration 900 >"$dir/launch.out" 2>"$dir/launch.err" &
+    --discovery-server auto --duration 900 "$@" >"$dir/launch.out" 2>"$dir/launch.err" &
   LAUNCH_PID=$!
   for _ in $(seq 50); do grep -q "started .* process" "$dir/launch.err" 2>/dev/null && break; sleep 0.1; done
   local ds=()

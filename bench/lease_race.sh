@@ -15,32 +15,28 @@
 # the processes that died by SIGABRT (docs/dds.md, "A departure that aborts
 # a peer").
 #
-# usage: bench/lease_race.sh [--bin DIR] [--time SECS] [--drones N]
-#                            [--churners K] [--life "MIN MAX"] [--out DIR]
+# usage: bench/lease_race.sh [--bin DIR] [--time SECS] [--mode lockstep|realtime]
+#          [--drones N] [--churners K] [--life "MIN MAX"] [--out DIR]
 set -u
 SRC="$(cd "$(dirname "$0")/.." && pwd)"
 source "$SRC/bench/bench_lib.sh"
-BIN="$SRC/build/default/bin" SECS=300 N=32 K=6 LIFE="2.0 4.5" OUT=""
+bench_swarm_options 300 "$@"
+N=32 K=6 LIFE="2.0 4.5"
+set -- "${BENCH_REST[@]}"
 while [ $# -gt 0 ]; do
   case "$1" in
-    --bin) BIN="$2"; shift 2 ;;
-    --time) SECS="$2"; shift 2 ;;
     --drones) N="$2"; shift 2 ;;
     --churners) K="$2"; shift 2 ;;
     --life) LIFE="$2"; shift 2 ;;
-    --out) OUT="$2"; shift 2 ;;
     *) echo "lease_race.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
+[ "$SECS" -le 840 ] || { echo "lease_race.sh: --time $SECS: at most 840 (the swarm holds 900 s)" >&2; exit 2; }
 read -r LIFE_MIN LIFE_MAX <<<"$LIFE"
 DIR="${OUT:-$(mktemp -d /tmp/lease_race.XXXXXX)}"
 mkdir -p "$DIR"
 scenario="$DIR/scenario.yaml"
 bench_scenario "$scenario"
-dom=$(bench_domain)
-"$BIN/ddswarm-launch" "$scenario" --drones "$N" --mode lockstep --domain "$dom" --log-dir "$DIR" \
-  --on-death keep --duration $((SECS + 400)) >"$DIR/launch.out" 2>"$DIR/launch.err" &
-LAUNCH_PID=$!
 churn_pids=()
 cleanup() {
   for p in "${churn_pids[@]}"; do kill -KILL "$p" 2>/dev/null; done
@@ -48,19 +44,15 @@ cleanup() {
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
-GS=("$BIN/ddswarm-gs" --config "$scenario" --domain "$dom")
-timeout 320 "${GS[@]}" wait-agents --count "$N" --timeout 300 >/dev/null 2>&1 ||
-  { echo "lease_race: $N agents not online (logs in $DIR)"; exit 1; }
-timeout 260 "${GS[@]}" takeoff --wait >/dev/null 2>&1 || { echo "lease_race: takeoff failed ($DIR)"; exit 1; }
-timeout 60 "${GS[@]}" hold --time 86400 >/dev/null 2>&1
+# --on-death keep: a swarm process that aborts is counted, and the rest fly on.
+bench_hold_swarm "$MODE" "$N" "$DIR" "$scenario" --on-death keep || exit 1
 
 life() { awk -v a="$LIFE_MIN" -v b="$LIFE_MAX" -v r="$RANDOM" 'BEGIN { printf "%.2f", a + (b - a) * r / 32767 }'; }
 churner() {  # one slot: ground stations that wait for agents that never come, stopped by SIGTERM
-  local slot="$1" end="$2" n=0 rc
+  local slot="$1" end="$2" rc
   while [ "$(date +%s)" -lt "$end" ]; do
     timeout -s TERM "$(life)" "${GS[@]}" wait-agents --count 100000 --timeout 600 >/dev/null 2>"$DIR/gs_$slot.err"
     rc=$?
-    n=$((n + 1))
     echo "$rc" >>"$DIR/gs_rc_$slot"
   done
 }
