@@ -252,7 +252,14 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
                                                true))});
       DdsConfig dds = opt.dds;
       dds.domain_id = domain;
-      DdsCommander gs(opt.gs, dds);
+      // The run's ground station announces a lease it will not outlive and
+      // leaves before its swarm: the swarm's processes never check its lease,
+      // and this process, which holds the whole experiment, has left DDS when
+      // they go. In Fast DDS 2.9.1 a process that removes a departing peer as
+      // its lease timer for that peer fires aborts (kOneShotLeaseS, docs/dds.md).
+      dds.lease_duration_s = one_shot_lease_s(dds.lease_duration_s);
+      std::optional<DdsCommander> commander(std::in_place, opt.gs, dds);
+      DdsCommander& gs = *commander;
       // The sim-time limit per run: the task fails after cfg.timeout_s of sim time.
       std::atomic<bool> finished{false};
       // A process that ends during the run fails it (rec.ok below); one that
@@ -280,6 +287,7 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       finished = true;
       watchdog.join();
       const double stop_start = wall_seconds();
+      commander.reset();
       procs.stop_all(3.0);
       times.teardown_s += wall_seconds() - stop_start;
       if (stop_requested() || !start_run_again(o, !died.empty(), starts)) break;
