@@ -60,7 +60,11 @@ std::uint32_t agent_shm_segment_bytes(std::size_t drones) {
   return static_cast<std::uint32_t>(std::min<std::size_t>(bytes, kShmSegmentBytes));
 }
 
-double one_shot_lease_s(double configured_s) { return std::max(configured_s, kOneShotLeaseS); }
+DdsConfig one_shot(DdsConfig c) {
+  if (!(c.announcement_period_s > 0.0)) c.announcement_period_s = c.lease_duration_s / 3.0;
+  c.lease_duration_s = std::max(c.lease_duration_s, kOneShotLeaseS);
+  return c;
+}
 
 void DdsConfig::validate() const {
   if (FILE* f = std::fopen(profiles_file.c_str(), "r")) {
@@ -73,6 +77,9 @@ void DdsConfig::validate() const {
   check_range("dds.participant_id", participant_id, -1, max_participant_id(domain_id));
   if (!(lease_duration_s >= 1.0 && lease_duration_s <= 300.0))
     throw FieldError("dds.lease_duration_s", to_text(lease_duration_s), "must be in [1, 300]");
+  if (!(announcement_period_s >= 0.0 && announcement_period_s < lease_duration_s))
+    throw FieldError("dds.announcement_period_s", to_text(announcement_period_s),
+                     "must be 0 (a third of the lease) or less than dds.lease_duration_s");
   if (discovery == Discovery::kInterface || discovery == Discovery::kPeers) {
     if (!is_ipv4(interface_ip))
       throw FieldError("dds.interface_ip", interface_ip.empty() ? "(empty)" : interface_ip,

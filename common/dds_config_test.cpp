@@ -70,12 +70,26 @@ TEST_F(SecureDir, BadOrMissingRoleRejected) {
 
 TEST(OneShotLease, ACommandThatComesAndGoesOutlivesNoPeersLeaseTimer) {
   // At the default 3 s lease a `status` of about 3 s left as its peers'
-  // timers fired; a longer configured lease is kept, and both stay valid.
-  EXPECT_EQ(one_shot_lease_s(DdsConfig{}.lease_duration_s), kOneShotLeaseS);
-  EXPECT_EQ(one_shot_lease_s(60.0), 60.0);
-  DdsConfig c;
-  c.lease_duration_s = one_shot_lease_s(c.lease_duration_s);
+  // timers fired. It announces itself as often as before, every second.
+  const DdsConfig c = one_shot(DdsConfig{});
+  EXPECT_EQ(c.lease_duration_s, kOneShotLeaseS);
+  EXPECT_DOUBLE_EQ(c.announcement_period_s, 1.0);
   EXPECT_NO_THROW(c.validate());
+  DdsConfig longer;
+  longer.lease_duration_s = 60.0;  // a longer configured lease is kept
+  EXPECT_EQ(one_shot(longer).lease_duration_s, 60.0);
+  EXPECT_DOUBLE_EQ(one_shot(longer).announcement_period_s, 20.0);
+}
+
+TEST(OneShotLease, AnAnnouncementPeriodNotShorterThanTheLeaseIsNamed) {
+  DdsConfig c;
+  c.announcement_period_s = 3.0;
+  try {
+    c.validate();
+    FAIL() << "accepted";
+  } catch (const FieldError& e) {
+    EXPECT_NE(std::string(e.what()).find("dds.announcement_period_s"), std::string::npos) << e.what();
+  }
 }
 
 TEST(DdsConfigSecurity, DefaultRoleKeepsTheUsersChoice) {

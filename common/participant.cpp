@@ -102,8 +102,8 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
   auto& wp = qos.wire_protocol();
   wp.participant_id = cfg.participant_id;
   wp.builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(cfg.lease_duration_s);
-  wp.builtin.discovery_config.leaseDuration_announcementperiod =
-      eprosima::fastrtps::Duration_t(cfg.lease_duration_s / 3.0);
+  wp.builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(
+      cfg.announcement_period_s > 0.0 ? cfg.announcement_period_s : cfg.lease_duration_s / 3.0);
 
   // Never the built-in all-interfaces transports.
   qos.transport().use_builtin_transports = false;

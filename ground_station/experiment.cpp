@@ -250,14 +250,13 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
         procs.start({"agent " + std::to_string(i),
                      common_args(agent_command(bin, std::to_string(i), false, p.scenario_file,
                                                true))});
-      DdsConfig dds = opt.dds;
+      DdsConfig dds = one_shot(opt.dds);
       dds.domain_id = domain;
       // The run's ground station announces a lease it will not outlive and
       // leaves before its swarm: the swarm's processes never check its lease,
       // and this process, which holds the whole experiment, has left DDS when
       // they go. In Fast DDS 2.9.1 a process that removes a departing peer as
       // its lease timer for that peer fires aborts (kOneShotLeaseS, docs/dds.md).
-      dds.lease_duration_s = one_shot_lease_s(dds.lease_duration_s);
       std::optional<DdsCommander> commander(std::in_place, opt.gs, dds);
       DdsCommander& gs = *commander;
       // The sim-time limit per run: the task fails after cfg.timeout_s of sim time.

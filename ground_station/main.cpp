@@ -282,7 +282,7 @@ int main(int argc, char** argv) {
     // A one-shot command comes and goes; it announces a lease it will not
     // outlive, so that no peer's lease timer for it fires as it leaves: in
     // Fast DDS 2.9.1 that race aborts the peer (kOneShotLeaseS, docs/dds.md).
-    if (!interactive) file.dds.lease_duration_s = one_shot_lease_s(file.dds.lease_duration_s);
+    if (!interactive) file.dds = one_shot(file.dds);
     // Give discovery a moment: the server's status is transient-local.
     // Status needs only the clock (a replayed recording has no server to command).
     // Through a discovery server, a participant that hears no server within
