@@ -21,9 +21,10 @@ bench_scenario() {
 
 # bench_hold_swarm MODE N DIR SCENARIO [LAUNCH_ARGS...]: starts ddswarm-launch
 # (N agent processes, MODE lockstep|realtime, logs in DIR, LAUNCH_ARGS added)
-# in the background for up to 900 s, waits for every agent, takes off and holds. Sets LAUNCH_PID and GS (the ground-station
-# command line for this swarm); returns 1 with a message when the swarm did
-# not come up. bench_stop_launch stops it by PID.
+# in the background for up to 900 s, waits for every agent, takes off and
+# holds. Sets LAUNCH_PID and GS (the ground-station command line for this
+# swarm); returns 1 with a message when the swarm did not come up.
+# bench_stop_launch stops it by PID.
 LAUNCH_PID=""
 bench_hold_swarm() {
   local mode="$1" n="$2" dir="$3" scenario="$4" dom addr

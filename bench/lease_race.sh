@@ -31,7 +31,8 @@ while [ $# -gt 0 ]; do
     *) echo "lease_race.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-[ "$SECS" -le 840 ] || { echo "lease_race.sh: --time $SECS: at most 840 (the swarm holds 900 s)" >&2; exit 2; }
+[ "$SECS" -le 840 ] ||
+  { echo "lease_race.sh: --time $SECS: at most 840 (the swarm holds 900 s)" >&2; exit 2; }
 read -r LIFE_MIN LIFE_MAX <<<"$LIFE"
 DIR="${OUT:-$(mktemp -d /tmp/lease_race.XXXXXX)}"
 mkdir -p "$DIR"
@@ -47,24 +48,30 @@ trap 'exit 130' INT TERM
 # --on-death keep: a swarm process that aborts is counted, and the rest fly on.
 bench_hold_swarm "$MODE" "$N" "$DIR" "$scenario" --on-death keep || exit 1
 
-life() { awk -v a="$LIFE_MIN" -v b="$LIFE_MAX" -v r="$RANDOM" 'BEGIN { printf "%.2f", a + (b - a) * r / 32767 }'; }
-churner() {  # one slot: ground stations that wait for agents that never come, stopped by SIGTERM
-  local slot="$1" end="$2" rc
+life() {
+  awk -v a="$LIFE_MIN" -v b="$LIFE_MAX" -v r="$RANDOM" 'BEGIN { printf "%.2f", a + (b - a) * r / 32767 }'
+}
+# One slot: ground stations that wait for agents that never come, each
+# stopped by SIGTERM; each exit status goes to gs_rc_SLOT (134: SIGABRT).
+churner() {
+  local slot="$1" end="$2"
   while [ "$(date +%s)" -lt "$end" ]; do
-    timeout -s TERM "$(life)" "${GS[@]}" wait-agents --count 100000 --timeout 600 >/dev/null 2>"$DIR/gs_$slot.err"
-    rc=$?
-    echo "$rc" >>"$DIR/gs_rc_$slot"
+    timeout -s TERM "$(life)" "${GS[@]}" wait-agents --count 100000 --timeout 600 \
+      >/dev/null 2>"$DIR/gs_$slot.err"
+    echo $? >>"$DIR/gs_rc_$slot"
   done
 }
 end=$(( $(date +%s) + SECS ))
-echo "lease_race: $N agents in lockstep hold, $K ground stations at a time living $LIFE_MIN-$LIFE_MAX s, for $SECS s"
+echo "lease_race: $N agents in $MODE hold, $K ground stations at a time" \
+  "living $LIFE_MIN-$LIFE_MAX s, for $SECS s"
 for k in $(seq "$K"); do churner "$k" "$end" & churn_pids+=($!); done
 while left=$(( end - $(date +%s) )); [ "$left" -gt 0 ]; do
   sleep $(( left < 30 ? left : 30 ))
   left=$(( end - $(date +%s) )); [ "$left" -lt 0 ] && left=0
   aborted=$(grep -c "killed by SIGABRT" "$DIR/launch.err")
   gone=$(cat "$DIR"/gs_rc_* 2>/dev/null | wc -l)
-  echo "lease_race: ${left}s left: $gone ground stations came and went; $aborted swarm process(es) aborted"
+  echo "lease_race: ${left}s left: $gone ground stations came and went;" \
+    "$aborted swarm process(es) aborted"
 done
 wait "${churn_pids[@]}" 2>/dev/null
 churn_pids=()

@@ -43,7 +43,8 @@ int max_participant_id(int domain_id);
 constexpr double kDiscoveryServerLeaseS = 20.0;
 
 /// The least lease a one-shot ground-station command announces (every
-/// ddswarm-gs subcommand but the console). Each peer checks a participant's
+/// ddswarm-gs subcommand but the console, and each experiment run's ground
+/// station; see one_shot). Each peer checks a participant's
 /// lease on a timer that first fires one announced lease after discovering
 /// it. In Debian's Fast DDS 2.9.1, a participant that says goodbye just as
 /// that timer fires aborts the peer (PDP.cpp:1140, "GUID_t::unknown() !=
@@ -51,13 +52,6 @@ constexpr double kDiscoveryServerLeaseS = 20.0;
 /// against a 3 s lease, aborted 4 agents of 32 once. A command that leaves
 /// before its lease has passed is never checked, so never races.
 constexpr double kOneShotLeaseS = 20.0;
-
-struct DdsConfig;
-/// A one-shot command's config: a lease of at least kOneShotLeaseS, and the
-/// announcements as often as the configured lease would have them (at a 20 s
-/// lease, every 6.7 s: the first Table 1 run of each pair then took 6.4 s
-/// longer to find its swarm).
-DdsConfig one_shot(DdsConfig c);
 
 /// The shared-memory transport's segment of every process but an agent: its
 /// outbox, where each sample it sends by that transport waits until every
@@ -120,6 +114,12 @@ struct DdsConfig {
   /// CA, permissions CA, governance, permissions, certificate, private key.
   std::vector<std::string> security_files() const;
 };
+
+/// A one-shot command's config: a lease of at least kOneShotLeaseS, and the
+/// announcements as often as the configured lease would have them (at a 20 s
+/// lease, every 6.7 s: the first Table 1 run of each pair then took 6.4 s
+/// longer to find its swarm).
+DdsConfig one_shot(DdsConfig c);
 
 /// Sets c.security_role to role unless the user chose one (--security-role).
 void default_security_role(DdsConfig& c, const std::string& role);

@@ -88,7 +88,8 @@ TEST(OneShotLease, AnAnnouncementPeriodNotShorterThanTheLeaseIsNamed) {
     c.validate();
     FAIL() << "accepted";
   } catch (const FieldError& e) {
-    EXPECT_NE(std::string(e.what()).find("dds.announcement_period_s"), std::string::npos) << e.what();
+    const std::string what = e.what();
+    EXPECT_NE(what.find("dds.announcement_period_s"), std::string::npos) << what;
   }
 }
 
