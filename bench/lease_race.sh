@@ -12,8 +12,8 @@
 # participant announces) after discovering it, and about once a lease after
 # that. This bench keeps CHURNERS `ddswarm-gs wait-agents` processes coming
 # and going, each stopped by SIGTERM after a random LIFE seconds, and counts
-# the processes that died by SIGABRT (docs/dds.md, "A departure that aborts
-# a peer").
+# the processes that died by SIGABRT (docs/dds.md, "A participant that leaves
+# as its peers check its lease aborts them").
 #
 # usage: bench/lease_race.sh [--bin DIR] [--time SECS] [--mode lockstep|realtime]
 #          [--drones N] [--churners K] [--life "MIN MAX"] [--out DIR]
@@ -61,6 +61,12 @@ churner() {
     echo $? >>"$DIR/gs_rc_$slot"
   done
 }
+# Sets GONE (ground stations that came and went) and ABORTED (swarm processes
+# that died by SIGABRT, as the launcher reports them).
+count() {
+  GONE=$(cat "$DIR"/gs_rc_* 2>/dev/null | wc -l)
+  ABORTED=$(grep -c "killed by SIGABRT" "$DIR/launch.err")
+}
 end=$(( $(date +%s) + SECS ))
 echo "lease_race: $N agents in $MODE hold, $K ground stations at a time" \
   "living $LIFE_MIN-$LIFE_MAX s, for $SECS s"
@@ -68,18 +74,16 @@ for k in $(seq "$K"); do churner "$k" "$end" & churn_pids+=($!); done
 while left=$(( end - $(date +%s) )); [ "$left" -gt 0 ]; do
   sleep $(( left < 30 ? left : 30 ))
   left=$(( end - $(date +%s) )); [ "$left" -lt 0 ] && left=0
-  aborted=$(grep -c "killed by SIGABRT" "$DIR/launch.err")
-  gone=$(cat "$DIR"/gs_rc_* 2>/dev/null | wc -l)
-  echo "lease_race: ${left}s left: $gone ground stations came and went;" \
-    "$aborted swarm process(es) aborted"
+  count
+  echo "lease_race: ${left}s left: $GONE ground stations came and went;" \
+    "$ABORTED swarm process(es) aborted"
 done
 wait "${churn_pids[@]}" 2>/dev/null
 churn_pids=()
-gone=$(cat "$DIR"/gs_rc_* | wc -l)
+count
 gs_abort=$(cat "$DIR"/gs_rc_* | grep -c '^134$')
-sw_abort=$(grep -c "killed by SIGABRT" "$DIR/launch.err")
 asserts=$(grep -l "check_remote_participant_liveliness" "$DIR"/*.log 2>/dev/null | wc -l)
-echo "ground stations that came and went: $gone (each one a departure for $((N + 1)) peers)"
-echo "swarm processes that died by SIGABRT: $sw_abort (logs with the PDP assertion: $asserts)"
+echo "ground stations that came and went: $GONE (each one a departure for $((N + 1)) peers)"
+echo "swarm processes that died by SIGABRT: $ABORTED (logs with the PDP assertion: $asserts)"
 echo "ground stations that died by SIGABRT: $gs_abort"
 echo "logs: $DIR"

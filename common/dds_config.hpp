@@ -117,8 +117,7 @@ struct DdsConfig {
 
 /// A one-shot command's config: a lease of at least kOneShotLeaseS, and the
 /// announcements as often as the configured lease would have them (at a 20 s
-/// lease, every 6.7 s: the first Table 1 run of each pair then took 6.4 s
-/// longer to find its swarm).
+/// lease, every 6.7 s, a Table 1 run waited 6.4 s to find its swarm).
 DdsConfig one_shot(DdsConfig c);
 
 /// Sets c.security_role to role unless the user chose one (--security-role).
