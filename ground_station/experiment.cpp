@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/config_error.hpp"
+#include "common/domain_claim.hpp"
 #include "common/process.hpp"
 #include "ground_station/gs_app.hpp"
 #include "ground_station/launcher.hpp"
@@ -153,9 +154,15 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
   if (fs::exists(csv)) fs::remove(csv);  // a fresh experiment; older rows would mix in
   const int total = static_cast<int>(cfg.sets.size()) * cfg.runs_per_set;
   const int jobs = std::max(1, std::min(opt.jobs, total));
-  if (opt.dds.domain_id + jobs - 1 > 232)
-    throw std::invalid_argument(fmt::format("--jobs {}: runs use domains {}..{}, past DDS's 232", jobs,
-                                            opt.dds.domain_id, opt.dds.domain_id + jobs - 1));
+  // One domain per job, claimed on this host for the whole experiment: a
+  // second experiment, a launched swarm or any live participant keeps its
+  // domain (common/domain_claim.hpp).
+  std::vector<std::string> skipped;
+  const std::vector<DomainClaim> domains = claim_free_domains(opt.dds.domain_id, jobs, &skipped);
+  if (static_cast<int>(domains.size()) < jobs)
+    throw std::invalid_argument(fmt::format(
+        "--jobs {}: only {} free DDS domains from {} to 232 on this host{}", jobs, domains.size(),
+        opt.dds.domain_id, skipped.empty() ? "" : " (" + skipped.front() + ", ...)"));
   const double t0 = wall_seconds();
 
   std::vector<RunPlan> plans;
@@ -196,6 +203,10 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
   check_sets(cfg, plans, bin);
   out << fmt::format("experiment '{}': {} sets x {} runs, {} mode, {} at a time, results in {}\n", cfg.name,
                      cfg.sets.size(), cfg.runs_per_set, cfg.mode, jobs, opt.out_dir);
+  for (const auto& why : skipped) out << "  not on " << why << "\n";
+  out << "  runs on DDS domain" << (jobs > 1 ? "s" : "");
+  for (std::size_t w = 0; w < domains.size(); ++w) out << (w ? ", " : " ") << domains[w].domain();
+  out << std::endl;
   std::mutex mu;  // out, the counters and the records below
   int started = 0, done = 0, failed = 0;
   std::vector<std::optional<RunRecord>> records(plans.size());
@@ -318,7 +329,7 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
   std::vector<std::thread> workers;
   for (int w = 0; w < jobs; ++w)
     workers.emplace_back([&, w] {
-      for (int i = next++; i < total && !stop_requested(); i = next++) run_one(i, opt.dds.domain_id + w);
+      for (int i = next++; i < total && !stop_requested(); i = next++) run_one(i, domains[w].domain());
     });
   for (auto& t : workers) t.join();
 

@@ -47,7 +47,7 @@ struct ExperimentOptions {
   GroundStationConfig gs;
   std::string bin_dir;              ///< where ddswarm-sim / ddswarm-agent live (default: next to us)
   std::string record_dir;           ///< when set, each run's DDS traffic goes to <record_dir>/<run>.mcap
-  int jobs = 1;                     ///< runs at a time; job w uses DDS domain dds.domain_id + w
+  int jobs = 1;                     ///< runs at a time, each job on a domain of its own from dds.domain_id up
   /// 0: one ddswarm-agent process per drone; K > 0: each run's agents in K
   /// agent-host processes (ddswarm-agent --ids). Lockstep results are the same
   /// to the last digit (mp_agent_host, mp_experiment_short); large swarms fly

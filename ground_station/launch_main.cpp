@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "common/cli_checks.hpp"
+#include "common/domain_claim.hpp"
 #include "common/process.hpp"
 #include "ground_station/experiment_config.hpp"
 #include "ground_station/gs_app.hpp"
@@ -138,6 +139,19 @@ int main(int argc, char** argv) {
       throw FieldError("--participant-id", app.get_option("--participant-id")->as<std::string>(),
                        "names one process; the launcher starts many (see docs/networking.md, large swarms)");
     auto file = load_gs_config(scenario);
+    // A launch that runs a server owns its domain on this host while it runs:
+    // an experiment passes over it, and a second launch says who has it
+    // (common/domain_claim.hpp). Agents alone join a swarm; they claim nothing.
+    std::optional<DomainClaim> claim;
+    if (only != "agents") {
+      DdsConfig dds = file.dds;
+      merge_cli(dds, dds_cli, app);
+      claim.emplace(dds.domain_id);
+      if (!claim->held())
+        throw FieldError(app.count("--domain") ? "--domain" : "dds.domain_id", std::to_string(dds.domain_id),
+                         "claimed on this host by " + claim->holder() +
+                             "; two swarms on one domain take each other's commands, so choose another");
+    }
     const int n = drones.value_or(file.drones);
     if (n < 1 || n > 1024) throw FieldError("--drones", std::to_string(n), "must be in [1, 1024]");
     std::vector<int> ids;

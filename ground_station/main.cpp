@@ -204,7 +204,7 @@ int main(int argc, char** argv) {
     std::string record_dir;
     experiment->add_option("--record", record_dir, "record each run's DDS traffic to DIR/<run>.mcap");
     int jobs = 1;
-    experiment->add_option("--jobs", jobs, "runs at a time, each on its own DDS domain (--domain, --domain + 1, ...)")
+    experiment->add_option("--jobs", jobs, "runs at a time, each on a DDS domain of its own (the first free ones from --domain up)")
         ->check(CLI::Range(1, 16));
     int exp_agent_hosts = 0;
     experiment->add_option("--agent-hosts", exp_agent_hosts,

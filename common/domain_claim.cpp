@@ -1,0 +1,123 @@
+#include "common/domain_claim.hpp"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace ddswarm {
+namespace {
+
+constexpr int kMaxDomain = 232;  // the last domain whose RTPS ports fit in 16 bits
+
+std::string claim_path(const std::string& dir, int domain_id) {
+  return dir + "/ddswarm_domain_" + std::to_string(domain_id) + ".lock";
+}
+
+/// This process's command line, its arguments joined by spaces.
+std::string own_command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (!raw.empty() && raw.back() == '\0') raw.pop_back();
+  for (char& c : raw)
+    if (c == '\0') c = ' ';
+  return raw;
+}
+
+}  // namespace
+
+DomainClaim::DomainClaim(int domain_id, const std::string& dir) : domain_(domain_id) {
+  const std::string path = claim_path(dir, domain_id);
+  const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    holder_ = "cannot open " + path + ": " + std::strerror(errno);
+    return;
+  }
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    std::ifstream in(path);
+    std::getline(in, holder_);
+    if (holder_.empty()) holder_ = "another process (" + path + ")";
+    close(fd);
+    return;
+  }
+  fd_ = fd;
+  const std::string who = "pid " + std::to_string(getpid()) + ": " + own_command_line() + "\n";
+  if (ftruncate(fd_, 0) == 0 && pwrite(fd_, who.data(), who.size(), 0) < 0) {
+    // The claim holds without its note; whoever finds it taken reads no name.
+  }
+}
+
+DomainClaim::~DomainClaim() {
+  if (fd_ >= 0) close(fd_);  // closing the only descriptor lets the lock go
+}
+
+DomainClaim::DomainClaim(DomainClaim&& other) noexcept
+    : domain_(other.domain_), fd_(other.fd_), holder_(std::move(other.holder_)) {
+  other.fd_ = -1;
+}
+
+DomainClaim& DomainClaim::operator=(DomainClaim&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) close(fd_);
+    domain_ = other.domain_;
+    fd_ = other.fd_;
+    holder_ = std::move(other.holder_);
+    other.fd_ = -1;
+  }
+  return *this;
+}
+
+bool domain_has_live_participants(int domain_id, const std::string& dir) {
+  // Every participant's shared-memory ports lie in its domain's block of 250
+  // RTPS ports; a live owner holds its port's "_el" lock (shm_clean.hpp).
+  const int lo = 7400 + 250 * domain_id, hi = lo + 250;
+  DIR* d = opendir(dir.c_str());
+  if (!d) return false;
+  bool live = false;
+  while (dirent* e = readdir(d)) {
+    int port = 0;
+    char tail[4] = {};
+    if (std::sscanf(e->d_name, "fastrtps_port%d%3s", &port, tail) != 2 ||
+        std::strcmp(tail, "_el") != 0 || port < lo || port >= hi)
+      continue;
+    const int fd = open((dir + "/" + e->d_name).c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) continue;
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      live = true;
+    } else {
+      flock(fd, LOCK_UN);
+    }
+    close(fd);
+    if (live) break;
+  }
+  closedir(d);
+  return live;
+}
+
+std::vector<DomainClaim> claim_free_domains(int first, int count,
+                                            std::vector<std::string>* why_skipped,
+                                            const std::string& dir) {
+  std::vector<DomainClaim> out;
+  for (int domain = first; domain <= kMaxDomain && static_cast<int>(out.size()) < count; ++domain) {
+    DomainClaim c(domain, dir);
+    std::string why;
+    if (!c.held())
+      why = c.holder();
+    else if (domain_has_live_participants(domain, dir))
+      why = "DDS participants on this host use it";
+    if (why.empty()) {
+      out.push_back(std::move(c));
+    } else if (why_skipped) {
+      why_skipped->push_back("domain " + std::to_string(domain) + ": " + why);
+    }
+  }
+  return out;
+}
+
+}  // namespace ddswarm

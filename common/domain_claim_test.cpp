@@ -1,0 +1,96 @@
+// Two experiments on one host must not share a DDS domain: each claims its
+// domains, and passes over any that another process claimed or that live
+// participants use.
+#include "common/domain_claim.hpp"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "common/participant.hpp"
+#include "common/process.hpp"
+
+namespace ddswarm {
+namespace {
+
+struct ClaimDir {
+  std::string path;
+  ClaimDir() {
+    char tmpl[] = "/tmp/ddswarm-claim-test.XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~ClaimDir() { std::system(("rm -rf " + path).c_str()); }
+};
+
+TEST(DomainClaim, ASecondClaimOfADomainFailsAndNamesItsHolder) {
+  ClaimDir dir;
+  std::string holder;
+  {
+    DomainClaim first(5, dir.path);
+    ASSERT_TRUE(first.held()) << first.holder();
+    DomainClaim second(5, dir.path);
+    EXPECT_FALSE(second.held());
+    holder = second.holder();
+    EXPECT_TRUE(DomainClaim(6, dir.path).held()) << "another domain is free";
+    DomainClaim moved = std::move(first);  // a claim moved keeps the domain
+    EXPECT_TRUE(moved.held());
+    EXPECT_FALSE(DomainClaim(5, dir.path).held());
+  }
+  EXPECT_NE(holder.find("pid " + std::to_string(getpid()) + ": "), std::string::npos) << holder;
+  EXPECT_NE(holder.find("common_shm_clean_test"), std::string::npos) << holder;
+  EXPECT_TRUE(DomainClaim(5, dir.path).held()) << "the claim ends with its owner";
+}
+
+TEST(DomainClaim, FreeDomainsPassOverClaimedOnesAndOnesWithLiveParticipants) {
+  ClaimDir dir;
+  DomainClaim taken(3, dir.path);
+  ASSERT_TRUE(taken.held());
+  // A live participant on domain 4: its port's lock is held, as Fast DDS's
+  // shared-memory transport holds it.
+  const std::string port = dir.path + "/fastrtps_port" + std::to_string(7400 + 250 * 4 + 12);
+  std::ofstream(port) << "x";
+  std::ofstream(port + "_el") << "";
+  const int fd = open((port + "_el").c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
+  // A dead one's port on domain 5: its lock file is left, and no one holds it.
+  const std::string dead = dir.path + "/fastrtps_port" + std::to_string(7400 + 250 * 5 + 10);
+  std::ofstream(dead + "_el") << "";
+
+  std::vector<std::string> why;
+  const auto got = claim_free_domains(3, 2, &why, dir.path);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].domain(), 5);
+  EXPECT_EQ(got[1].domain(), 6);
+  ASSERT_EQ(why.size(), 2u);
+  EXPECT_EQ(why[0].rfind("domain 3: pid ", 0), 0u) << why[0];
+  EXPECT_EQ(why[1], "domain 4: DDS participants on this host use it");
+  EXPECT_FALSE(DomainClaim(5, dir.path).held()) << "what was handed out stays claimed";
+
+  close(fd);
+  EXPECT_FALSE(domain_has_live_participants(4, dir.path)) << "its owner is gone";
+  EXPECT_EQ(claim_free_domains(230, 5, nullptr, dir.path).size(), 3u) << "230..232, no further";
+}
+
+// The same test against Fast DDS itself: a participant on a domain shows
+// while it lives, and not after.
+TEST(DomainClaim, ALiveParticipantMarksItsDomainInUse) {
+  DdsConfig cfg;
+  cfg.domain_id = 170 + static_cast<int>(random_instance() % 50);
+  if (domain_has_live_participants(cfg.domain_id))
+    GTEST_SKIP() << "domain " << cfg.domain_id << " is in use by another test";
+  {
+    Participant p(cfg, "domain_claim_test");
+    if (!p.shared_memory()) GTEST_SKIP() << "no shared-memory transport in this build";
+    EXPECT_TRUE(domain_has_live_participants(cfg.domain_id));
+  }
+  EXPECT_FALSE(domain_has_live_participants(cfg.domain_id));
+}
+
+}  // namespace
+}  // namespace ddswarm
