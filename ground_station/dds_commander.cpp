@@ -333,25 +333,27 @@ bool DdsCommander::wait_airborne(int count, double timeout_s) {
   return impl_->wait(timeout_s, [&] { return impl_->sim && impl_->sim->airborne() == count; });
 }
 
+bool climb_over(const ClimbWord& w) {
+  auto past = [](const std::optional<Phase>& p) {
+    return p && *p != Phase::kTakeoff && *p != Phase::kIdle;
+  };
+  return past(w.heartbeat) || past(w.server);
+}
+
 bool DdsCommander::wait_takeoff_done(int count, double timeout_s) {
   return impl_->wait(timeout_s, [&] {
     if (!impl_->sim || impl_->sim->airborne() < count) return false;
-    auto climbing = [](Phase p) { return p == Phase::kTakeoff || p == Phase::kIdle; };
     const auto& sim = *impl_->sim;
     for (int id : impl_->online_locked()) {
-      // Only a heartbeat sent after the command tells the agent's phase now: in
-      // lockstep a whole climb can pass between two heartbeats.
+      ClimbWord w;
       auto it = impl_->agents.find(id);
-      if (it != impl_->agents.end() && it->second.wall > impl_->last_command_wall) {
-        if (climbing(it->second.phase)) return false;
-        continue;
-      }
-      // Or the server's word, for an agent whose heartbeats never reach us:
-      // it has accepted the command and reports a phase past the climb.
+      if (it != impl_->agents.end() && it->second.wall > impl_->last_command_wall)
+        w.heartbeat = it->second.phase;
+      // The server's word, also for an agent whose heartbeats never reach us.
       const auto k = static_cast<std::size_t>(id);
-      if (!impl_->accepted_by(id, impl_->last_seq) || k >= sim.phase().size() ||
-          climbing(static_cast<Phase>(sim.phase()[k])))
-        return false;
+      if (impl_->accepted_by(id, impl_->last_seq) && k < sim.phase().size())
+        w.server = static_cast<Phase>(sim.phase()[k]);
+      if (!climb_over(w)) return false;
     }
     return true;
   });

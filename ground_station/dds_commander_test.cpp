@@ -89,6 +89,21 @@ TEST(DdsCommander, WaitsForTheServerToHearEveryAgentNotOnlyItself) {
   EXPECT_TRUE(gs.wait_for_swarm(6, 10.0));
 }
 
+// A take-off ends for an agent once either word has it past the climb. A
+// heartbeat the agent sent mid-climb, then the server's newer word that it
+// holds: over, with no wait for the agent's next heartbeat (a quarter second
+// in half of Table 1's runs when the heartbeat outweighed the server).
+TEST(ClimbOver, EitherWordPastTheClimbEndsIt) {
+  EXPECT_TRUE(climb_over({Phase::kTakeoff, Phase::kHold}));
+  EXPECT_TRUE(climb_over({Phase::kHold, Phase::kTakeoff}));
+  EXPECT_TRUE(climb_over({Phase::kHold, std::nullopt}));
+  EXPECT_TRUE(climb_over({std::nullopt, Phase::kHold}));
+  EXPECT_FALSE(climb_over({Phase::kTakeoff, Phase::kTakeoff}));
+  EXPECT_FALSE(climb_over({Phase::kTakeoff, std::nullopt}));
+  EXPECT_FALSE(climb_over({std::nullopt, Phase::kIdle}));  // accepted, not yet climbing
+  EXPECT_FALSE(climb_over({std::nullopt, std::nullopt}));  // no word since the command
+}
+
 // An experiment's run whose server died at start-up: the wait ends at once,
 // not after its timeout (a minute per run before).
 TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
