@@ -8,27 +8,19 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-#include <cstdlib>
-#include <fstream>
 #include <string>
 
 #include "common/participant.hpp"
 #include "common/process.hpp"
+#include "common/shm_test_dir.hpp"
 
 namespace ddswarm {
 namespace {
 
-struct ClaimDir {
-  std::string path;
-  ClaimDir() {
-    char tmpl[] = "/tmp/ddswarm-claim-test.XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~ClaimDir() { std::system(("rm -rf " + path).c_str()); }
-};
+using test_util::TempDir;
 
 TEST(DomainClaim, ASecondClaimOfADomainFailsAndNamesItsHolder) {
-  ClaimDir dir;
+  TempDir dir;
   std::string holder;
   {
     DomainClaim first(5, dir.path);
@@ -47,20 +39,18 @@ TEST(DomainClaim, ASecondClaimOfADomainFailsAndNamesItsHolder) {
 }
 
 TEST(DomainClaim, FreeDomainsPassOverClaimedOnesAndOnesWithLiveParticipants) {
-  ClaimDir dir;
+  TempDir dir;
   DomainClaim taken(3, dir.path);
   ASSERT_TRUE(taken.held());
   // A live participant on domain 4: its port's lock is held, as Fast DDS's
   // shared-memory transport holds it.
-  const std::string port = dir.path + "/fastrtps_port" + std::to_string(7400 + 250 * 4 + 12);
-  std::ofstream(port) << "x";
-  std::ofstream(port + "_el") << "";
-  const int fd = open((port + "_el").c_str(), O_RDONLY);
+  const std::string port = "fastrtps_port" + std::to_string(7400 + 250 * 4 + 12);
+  dir.touch(port);
+  const int fd = open(dir.touch(port + "_el", 0).c_str(), O_RDONLY);
   ASSERT_GE(fd, 0);
   ASSERT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
   // A dead one's port on domain 5: its lock file is left, and no one holds it.
-  const std::string dead = dir.path + "/fastrtps_port" + std::to_string(7400 + 250 * 5 + 10);
-  std::ofstream(dead + "_el") << "";
+  dir.touch("fastrtps_port" + std::to_string(7400 + 250 * 5 + 10) + "_el", 0);
 
   std::vector<std::string> why;
   const auto got = claim_free_domains(3, 2, &why, dir.path);

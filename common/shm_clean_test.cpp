@@ -1,6 +1,7 @@
 #include "common/shm_clean.hpp"
 
 #include "common/dds_config.hpp"
+#include "common/shm_test_dir.hpp"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -16,20 +17,7 @@ using ddswarm::clean_zombie_shm;
 
 namespace {
 
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/ddswarm-shm-test.XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { std::system(("rm -rf " + path).c_str()); }
-  std::string touch(const std::string& name, std::size_t bytes = 4096) const {
-    std::string p = path + "/" + name;
-    std::ofstream(p) << std::string(bytes, 'x');
-    return p;
-  }
-  bool has(const std::string& name) const { return access((path + "/" + name).c_str(), F_OK) == 0; }
-};
+using ddswarm::test_util::TempDir;
 
 /// Maps a file as a live process that uses it does (listed in /proc/self/maps).
 struct Mapping {
