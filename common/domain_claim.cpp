@@ -2,7 +2,9 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -34,7 +36,16 @@ std::string own_command_line() {
 
 DomainClaim::DomainClaim(int domain_id, const std::string& dir) : domain_(domain_id) {
   const std::string path = claim_path(dir, domain_id);
-  const int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  // Any user may claim a domain: the file is made writable by all, and one
+  // that another user made without that (an older umask) is locked read-only.
+  bool writable = true;
+  int fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  if (fd >= 0) {
+    fchmod(fd, 0666);  // not ours to change if another user made it: no matter
+  } else {
+    writable = false;
+    fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  }
   if (fd < 0) {
     holder_ = "cannot open " + path + ": " + std::strerror(errno);
     return;
@@ -42,13 +53,18 @@ DomainClaim::DomainClaim(int domain_id, const std::string& dir) : domain_(domain
   if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
     std::ifstream in(path);
     std::getline(in, holder_);
-    if (holder_.empty()) holder_ = "another process (" + path + ")";
+    // A holder that could not write its note (another user's file) leaves
+    // the last writer's: name no one rather than a process that is gone.
+    long pid = 0;
+    if (std::sscanf(holder_.c_str(), "pid %ld:", &pid) != 1 || pid <= 0 ||
+        (kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH))
+      holder_ = "another process (" + path + ")";
     close(fd);
     return;
   }
   fd_ = fd;
   const std::string who = "pid " + std::to_string(getpid()) + ": " + own_command_line() + "\n";
-  if (ftruncate(fd_, 0) == 0 && pwrite(fd_, who.data(), who.size(), 0) < 0) {
+  if (writable && ftruncate(fd_, 0) == 0 && pwrite(fd_, who.data(), who.size(), 0) < 0) {
     // The claim holds without its note; whoever finds it taken reads no name.
   }
 }

@@ -8,6 +8,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <fstream>
 #include <string>
 
 #include "common/participant.hpp"
@@ -36,6 +37,22 @@ TEST(DomainClaim, ASecondClaimOfADomainFailsAndNamesItsHolder) {
   EXPECT_NE(holder.find("pid " + std::to_string(getpid()) + ": "), std::string::npos) << holder;
   EXPECT_NE(holder.find("common_shm_clean_test"), std::string::npos) << holder;
   EXPECT_TRUE(DomainClaim(5, dir.path).held()) << "the claim ends with its owner";
+}
+
+// A holder that could not write its note (a file another user made) leaves
+// the last one's in place: a gone process is not named.
+TEST(DomainClaim, AStaleNoteNamesNoOne) {
+  TempDir dir;
+  const std::string lock = dir.path + "/ddswarm_domain_7.lock";
+  std::ofstream(lock) << "pid 2147483646: a launch long gone\n";
+  const int fd = open(lock.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
+  DomainClaim c(7, dir.path);
+  EXPECT_FALSE(c.held());
+  EXPECT_EQ(c.holder(), "another process (" + lock + ")");
+  close(fd);
+  EXPECT_TRUE(DomainClaim(7, dir.path).held());
 }
 
 TEST(DomainClaim, FreeDomainsPassOverClaimedOnesAndOnesWithLiveParticipants) {
