@@ -52,7 +52,9 @@ void load(YamlSection s, DdsConfig& c) {
   s.finish();
 }
 
-int rtps_unicast_port(int domain_id, int participant_id) { return 7400 + 250 * domain_id + 10 + 2 * participant_id; }
+int rtps_unicast_port(int domain_id, int participant_id) {
+  return rtps_port_base(domain_id) + 10 + 2 * participant_id;
+}
 int max_participant_id(int domain_id) { return (65535 - 1 - rtps_unicast_port(domain_id, 0)) / 2; }
 
 std::uint32_t agent_shm_segment_bytes(std::size_t drones) {
@@ -72,7 +74,7 @@ void DdsConfig::validate() const {
   } else {
     throw FieldError("dds.profiles_file", profiles_file, "cannot read this file");
   }
-  check_range("dds.domain_id", domain_id, 0, 232);
+  check_range("dds.domain_id", domain_id, 0, kMaxDomainId);
   // RTPS ports: 7400 + 250 * domain + 11 + 2 * participant_id must stay below 65536.
   check_range("dds.participant_id", participant_id, -1, max_participant_id(domain_id));
   if (!(lease_duration_s >= 1.0 && lease_duration_s <= 300.0))

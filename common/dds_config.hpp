@@ -24,6 +24,13 @@ enum class Discovery {
   kDiscoveryServer,  ///< opt-in: Fast DDS discovery server at ip:port
 };
 
+/// The last DDS domain whose RTPS ports fit in 16 bits.
+constexpr int kMaxDomainId = 232;
+
+/// The first of the 250 RTPS ports of domain_id (the default port mapping,
+/// 7400 + 250*domain): every participant's ports in that domain lie above it.
+constexpr int rtps_port_base(int domain_id) { return 7400 + 250 * domain_id; }
+
 /// The RTPS metatraffic unicast port of a participant (the default port
 /// mapping: 7400 + 250*domain + 10 + 2*id); its user-data port is one above.
 int rtps_unicast_port(int domain_id, int participant_id);
