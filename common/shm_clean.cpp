@@ -8,6 +8,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <vector>
@@ -32,10 +34,11 @@ std::vector<std::string> list_dir(const std::string& dir) {
   return out;
 }
 
-/// True when some process holds an flock on path (as Fast DDS's owners do).
-bool locked(const std::string& path) {
+/// True when some process holds an flock on path (as Fast DDS's owners do);
+/// if_unknown when the file cannot be opened.
+bool locked(const std::string& path, bool if_unknown = true) {
   int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return true;  // cannot tell: leave it
+  if (fd < 0) return if_unknown;  // cannot tell (cleaning: leave it)
   bool held = flock(fd, LOCK_EX | LOCK_NB) != 0;
   if (!held) flock(fd, LOCK_UN);
   close(fd);
@@ -133,6 +136,20 @@ int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& di
     if (!held(meta) && !held(meta + 1)) return id;
   }
   return -1;
+}
+
+bool domain_has_live_participants(int domain_id, const std::string& dir) {
+  // Every participant's shared-memory ports lie in its domain's block of 250
+  // RTPS ports; a live owner holds its port's "_el" lock (see above).
+  const int lo = rtps_port_base(domain_id), hi = lo + 250;
+  for (const auto& n : list_dir(dir)) {
+    int port = 0;
+    char tail[4] = {};
+    if (std::sscanf(n.c_str(), "fastrtps_port%d%3s", &port, tail) == 2 &&
+        std::strcmp(tail, "_el") == 0 && port >= lo && port < hi && locked(dir + "/" + n, false))
+      return true;
+  }
+  return false;
 }
 
 }  // namespace ddswarm

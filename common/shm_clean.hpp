@@ -36,4 +36,9 @@ ShmCleanReport clean_zombie_shm(const std::string& dir = "/dev/shm");
 int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir = "/dev/shm",
                                 int first_id = 0);
 
+/// True when some live process on this host has Fast DDS shared-memory ports
+/// open in domain_id (a participant of any tool). Participants with the
+/// shared-memory transport off do not show.
+bool domain_has_live_participants(int domain_id, const std::string& dir = "/dev/shm");
+
 }  // namespace ddswarm

@@ -1,6 +1,8 @@
 #include "common/shm_clean.hpp"
 
 #include "common/dds_config.hpp"
+#include "common/participant.hpp"
+#include "common/process.hpp"
 #include "common/shm_test_dir.hpp"
 
 #include <fcntl.h>
@@ -123,4 +125,19 @@ TEST(ShmClean, ParticipantIdClearOfPortsADeadProcessLeft) {
   // From a first id on: 1 is held, 2 is clear.
   EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path, 1), 2);
   EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path, 3), 3);
+}
+
+// A domain is in use while a Fast DDS participant of this host is on it
+// (its shared-memory ports are locked), and not after.
+TEST(ShmClean, ALiveParticipantMarksItsDomainInUse) {
+  ddswarm::DdsConfig cfg;
+  cfg.domain_id = 170 + static_cast<int>(ddswarm::random_instance() % 50);
+  if (ddswarm::domain_has_live_participants(cfg.domain_id))
+    GTEST_SKIP() << "domain " << cfg.domain_id << " is in use by another test";
+  {
+    ddswarm::Participant p(cfg, "shm_clean_test");
+    if (!p.shared_memory()) GTEST_SKIP() << "no shared-memory transport in this build";
+    EXPECT_TRUE(ddswarm::domain_has_live_participants(cfg.domain_id));
+  }
+  EXPECT_FALSE(ddswarm::domain_has_live_participants(cfg.domain_id));
 }

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "common/config_error.hpp"
-#include "common/domain_claim.hpp"
 #include "common/process.hpp"
+#include "ground_station/domain_claim.hpp"
 #include "ground_station/gs_app.hpp"
 #include "ground_station/launcher.hpp"
 #include "ground_station/report.hpp"
@@ -156,7 +156,7 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
   const int jobs = std::max(1, std::min(opt.jobs, total));
   // One domain per job, claimed on this host for the whole experiment: a
   // second experiment, a launched swarm or any live participant keeps its
-  // domain (common/domain_claim.hpp).
+  // domain (ground_station/domain_claim.hpp).
   std::vector<std::string> skipped;
   const std::vector<DomainClaim> domains = claim_free_domains(opt.dds.domain_id, jobs, &skipped);
   if (static_cast<int>(domains.size()) < jobs)

@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "common/cli_checks.hpp"
-#include "common/domain_claim.hpp"
 #include "common/process.hpp"
+#include "ground_station/domain_claim.hpp"
 #include "ground_station/experiment_config.hpp"
 #include "ground_station/gs_app.hpp"
 #include "ground_station/launcher.hpp"
@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
     auto file = load_gs_config(scenario);
     // A launch that runs a server owns its domain on this host while it runs:
     // an experiment passes over it, and a second launch says who has it
-    // (common/domain_claim.hpp). Agents alone join a swarm; they claim nothing.
+    // (ground_station/domain_claim.hpp). Agents alone join a swarm; they claim nothing.
     std::optional<DomainClaim> claim;
     if (only != "agents") {
       DdsConfig dds = file.dds;

@@ -1,6 +1,5 @@
-#include "common/domain_claim.hpp"
+#include "ground_station/domain_claim.hpp"
 
-#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
@@ -11,12 +10,12 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <sstream>
+
+#include "common/dds_config.hpp"
+#include "common/shm_clean.hpp"
 
 namespace ddswarm {
 namespace {
-
-constexpr int kMaxDomain = 232;  // the last domain whose RTPS ports fit in 16 bits
 
 std::string claim_path(const std::string& dir, int domain_id) {
   return dir + "/ddswarm_domain_" + std::to_string(domain_id) + ".lock";
@@ -89,38 +88,11 @@ DomainClaim& DomainClaim::operator=(DomainClaim&& other) noexcept {
   return *this;
 }
 
-bool domain_has_live_participants(int domain_id, const std::string& dir) {
-  // Every participant's shared-memory ports lie in its domain's block of 250
-  // RTPS ports; a live owner holds its port's "_el" lock (shm_clean.hpp).
-  const int lo = 7400 + 250 * domain_id, hi = lo + 250;
-  DIR* d = opendir(dir.c_str());
-  if (!d) return false;
-  bool live = false;
-  while (dirent* e = readdir(d)) {
-    int port = 0;
-    char tail[4] = {};
-    if (std::sscanf(e->d_name, "fastrtps_port%d%3s", &port, tail) != 2 ||
-        std::strcmp(tail, "_el") != 0 || port < lo || port >= hi)
-      continue;
-    const int fd = open((dir + "/" + e->d_name).c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) continue;
-    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
-      live = true;
-    } else {
-      flock(fd, LOCK_UN);
-    }
-    close(fd);
-    if (live) break;
-  }
-  closedir(d);
-  return live;
-}
-
 std::vector<DomainClaim> claim_free_domains(int first, int count,
                                             std::vector<std::string>* why_skipped,
                                             const std::string& dir) {
   std::vector<DomainClaim> out;
-  for (int domain = first; domain <= kMaxDomain && static_cast<int>(out.size()) < count; ++domain) {
+  for (int domain = first; domain <= kMaxDomainId && static_cast<int>(out.size()) < count; ++domain) {
     DomainClaim c(domain, dir);
     std::string why;
     if (!c.held())

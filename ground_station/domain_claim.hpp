@@ -37,13 +37,9 @@ class DomainClaim {
   std::string holder_;
 };
 
-/// True when some live process on this host has Fast DDS shared-memory ports
-/// open in domain_id (a participant of any tool, claimed or not). Participants
-/// with the shared-memory transport off do not show.
-bool domain_has_live_participants(int domain_id, const std::string& dir = "/dev/shm");
-
-/// Claims count domains for whole swarms, from first upward (to 232): each one
-/// unclaimed and without live participants on this host. Fewer than count
+/// Claims count domains for whole swarms, from first upward (to kMaxDomainId):
+/// each one unclaimed and without live participants on this host
+/// (domain_has_live_participants, common/shm_clean.hpp). Fewer than count
 /// when the range runs out. why_skipped, if given, gets one line per domain
 /// passed over ("domain 0: pid 123: ddswarm-gs experiment ...").
 std::vector<DomainClaim> claim_free_domains(int first, int count,
