@@ -142,10 +142,10 @@ int main(int argc, char** argv) {
     // A launch that runs a server owns its domain on this host while it runs:
     // an experiment passes over it, and a second launch says who has it
     // (ground_station/domain_claim.hpp). Agents alone join a swarm; they claim nothing.
+    DdsConfig dds = file.dds;  // the swarm's domain and network: the file, then the flags
+    merge_cli(dds, dds_cli, app);
     std::optional<DomainClaim> claim;
     if (only != "agents") {
-      DdsConfig dds = file.dds;
-      merge_cli(dds, dds_cli, app);
       claim.emplace(dds.domain_id);
       if (!claim->held())
         throw FieldError(app.count("--domain") ? "--domain" : "dds.domain_id", std::to_string(dds.domain_id),
@@ -248,8 +248,6 @@ int main(int argc, char** argv) {
     if (agent_hosts == 0 && !ids.empty() && agent_participant_id(n, ids.front()) >= 0) {
       int lo = 0, hi = -1;
       std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> lo >> hi;
-      DdsConfig dds = file.dds;
-      merge_cli(dds, dds_cli, app);
       const std::string w = ephemeral_port_warning(dds.domain_id, agent_participant_id(n, ids.front()),
                                                    agent_participant_id(n, ids.back()), lo, hi);
       if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
