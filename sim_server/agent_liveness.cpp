@@ -8,4 +8,12 @@ double agent_silence_limit(double now_s, double newest_heard_s, double agent_tim
              : agent_timeout_s;
 }
 
+double SwarmSilence::limit(double now_s, double newest_heard_s, double agent_timeout_s) {
+  const double t = agent_silence_limit(now_s, newest_heard_s, agent_timeout_s);
+  const bool silent = t > agent_timeout_s;
+  if (silent_ && !silent) heard_again_s_ = now_s;
+  silent_ = silent;
+  return t;
+}
+
 }  // namespace ddswarm::sim

@@ -21,4 +21,27 @@ constexpr double kSilentSwarmTimeouts = 3.0;
 /// newest_heard_s: when any live agent was last heard.
 double agent_silence_limit(double now_s, double newest_heard_s, double agent_timeout_s);
 
+/// A swarm-wide silence as the server's checks see it, one check after
+/// another. When a live agent is heard again after one, the samples queued
+/// behind its own come in over the next moments: every live agent's silence
+/// then counts from that moment, not from its last word. In mp_fault_agent_kill
+/// a 1 s stall of the server's port ended with two agents heard, and the
+/// three others, back 4 ms later, had been declared lost at that instant.
+class SwarmSilence {
+ public:
+  /// Call at every check: the timeout that applies now (agent_silence_limit).
+  /// newest_heard_s: when any live agent was last heard.
+  double limit(double now_s, double newest_heard_s, double agent_timeout_s);
+  /// True when the last check found the whole swarm silent.
+  bool silent() const { return silent_; }
+  /// From when an agent last heard at last_heard_s counts as silent.
+  double silent_since(double last_heard_s) const {
+    return last_heard_s > heard_again_s_ ? last_heard_s : heard_again_s_;
+  }
+
+ private:
+  bool silent_ = false;
+  double heard_again_s_ = -1e300;  ///< when the last swarm-wide silence ended
+};
+
 }  // namespace ddswarm::sim

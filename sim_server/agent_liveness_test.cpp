@@ -23,3 +23,32 @@ TEST(AgentSilence, AStalledPortLosesNoAgentThatWasHeardBeforeIt) {
   // the others' heartbeats (4 a second) keep the newest within 0.25 s.
   EXPECT_DOUBLE_EQ(agent_silence_limit(10.0, 9.75, 1.0), 1.0);
 }
+
+TEST(AgentSilence, AgentsQueuedBehindTheFirstOneHeardAfterAStallAreNotLost) {
+  // mp_fault_agent_kill in a fresh clone: agent 3 killed at t = 9.40, the
+  // server's port stalled until 10.40; agents 1 and 5 came in first, and 0,
+  // 2 and 4 four milliseconds later, each last heard at 9.39 before.
+  SwarmSilence watch;
+  EXPECT_DOUBLE_EQ(watch.limit(9.80, 9.39, 1.0), 1.0);
+  EXPECT_FALSE(watch.silent());
+  EXPECT_DOUBLE_EQ(watch.limit(10.00, 9.39, 1.0), kSilentSwarmTimeouts);  // the swarm is silent
+  EXPECT_TRUE(watch.silent());
+  const double t = watch.limit(10.40, 10.40, 1.0);  // agent 1 heard again
+  EXPECT_DOUBLE_EQ(t, 1.0);
+  EXPECT_FALSE(watch.silent());
+  EXPECT_LE(10.40 - watch.silent_since(9.39), t) << "agent 0, queued behind agent 1, is not lost";
+  // Agent 3 stays silent: lost one timeout after the stall ended.
+  watch.limit(11.30, 11.25, 1.0);
+  EXPECT_LE(11.30 - watch.silent_since(9.39), 1.0);
+  watch.limit(11.45, 11.40, 1.0);
+  EXPECT_GT(11.45 - watch.silent_since(9.39), 1.0);
+  // An agent heard since counts from its own word.
+  EXPECT_DOUBLE_EQ(watch.silent_since(11.40), 11.40);
+}
+
+TEST(AgentSilence, WithoutAStallADeadAgentIsLostAfterOneTimeout) {
+  SwarmSilence watch;  // the others' heartbeats keep the newest within 0.25 s
+  const double t = watch.limit(10.30, 10.20, 1.0);
+  EXPECT_GT(10.30 - watch.silent_since(9.25), t);
+  EXPECT_FALSE(watch.silent());
+}

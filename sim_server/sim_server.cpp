@@ -132,7 +132,7 @@ struct SimServer::Impl {
   std::atomic<std::uint64_t> rival_instance{0};
   bool rival_logged = false;
   std::int64_t scene_published_ns = 0;  // system clock, as the scene's source timestamp
-  bool swarm_silent = false;  // expire_agents: no live agent heard lately (agent_silence_limit)
+  SwarmSilence swarm_silence;  // expire_agents: whether, and since when, no agent was heard
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   // What a ground station waits for changed since the last SimStatus: an
@@ -439,16 +439,16 @@ struct SimServer::Impl {
     double newest = -1e9;
     for (const auto& s : slots)
       if (s.live) newest = std::max(newest, s.last_heard_wall);
-    const double timeout = agent_silence_limit(now, newest, cfg.sim.agent_timeout_s);
-    const bool all_silent = newest > -1e9 && timeout > cfg.sim.agent_timeout_s;
-    if (all_silent && !swarm_silent)
+    if (newest <= -1e9) return;  // no live agent
+    const bool was_silent = swarm_silence.silent();
+    const double timeout = swarm_silence.limit(now, newest, cfg.sim.agent_timeout_s);
+    if (swarm_silence.silent() && !was_silent)
       spdlog::warn("no agent heard for {:.1f} s: waiting up to {:.1f} s before declaring any lost "
                    "(the silence may be this server's)",
                    now - newest, timeout);
-    swarm_silent = all_silent;
     for (int i = 0; i < n; ++i) {
       Slot& s = slots[i];
-      if (s.live && now - s.last_heard_wall > timeout) {
+      if (s.live && now - swarm_silence.silent_since(s.last_heard_wall) > timeout) {
         s.live = false;
         s.owner = 0;
         if (!s.answered) --unanswered;
