@@ -10,10 +10,11 @@
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
 #include "common/id_ranges.hpp"
+#include "common/participant.hpp"
 #include "common/process.hpp"
 
 int main(int argc, char** argv) {
-  return ddswarm::run_main("ddswarm-agent", [&] {
+  const int rc = ddswarm::run_main("ddswarm-agent", [&] {
     CLI::App app{"ddswarm-agent: flies one drone by repulsion-attraction and obstacle avoidance"};
     std::string config;
     std::optional<int> id;
@@ -96,4 +97,5 @@ int main(int argc, char** argv) {
     }
     return 0;
   });
+  return ddswarm::end_process(rc);
 }

@@ -3,6 +3,7 @@
 #include "common/shm_clean.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
@@ -11,6 +12,9 @@
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
 #include <bit>
 #include <filesystem>
 #include <mutex>
@@ -313,6 +317,22 @@ Participant::~Participant() {
   if (!participant_) return;
   close();
   fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+int end_process(int code) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  return code;
+#else
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  for (int d = 0; d <= kMaxDomainId; ++d)
+    if (!factory->lookup_participants(static_cast<fdds::DomainId_t>(d)).empty()) return code;
+  spdlog::shutdown();
+  fdds::Log::Flush();
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(code);
+#endif
 }
 
 }  // namespace ddswarm

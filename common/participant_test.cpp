@@ -2,6 +2,8 @@
 // back as a new participant, not under the GUID it left with; and a
 // per-tick stream read best-effort by the swarm stays reliable for tools.
 #include <gtest/gtest.h>
+#include <spdlog/sinks/basic_file_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <atomic>
@@ -481,6 +483,50 @@ TEST(Participant, AJoiningStateReaderGetsTheNewestStateOnly) {
   }
   server.close();
   first.close();
+}
+
+// A process that has left DDS ends at once (end_process), and whatever it
+// had written but not yet flushed reaches its files: a stdio stream left
+// open and an spdlog file logger never flushed.
+TEST(EndProcess, WithEveryParticipantGoneExitsWithItsCodeAndLosesNoOutput) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "sanitizer builds exit normally (end_process returns)";
+#endif
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  // A fixed name: the child runs this test again from its start.
+  const std::string dir = ::testing::TempDir() + "ddswarm_end_process_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  EXPECT_EXIT(
+      {
+        DdsConfig cfg;
+        cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+        { Participant p(cfg, "participant_test leaving"); }
+        FILE* f = std::fopen((dir + "/stdio.txt").c_str(), "w");
+        std::fputs("the stdio line", f);  // left open: only a flush writes it
+        auto log = spdlog::basic_logger_mt("end_process_test", dir + "/spdlog.txt");
+        log->flush_on(spdlog::level::off);
+        log->info("the spdlog line");
+        end_process(7);
+        std::exit(1);  // not reached when end_process ends the process
+      },
+      ::testing::ExitedWithCode(7), "");
+  auto text = [&](const std::string& name) {
+    std::ifstream in(dir + "/" + name);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(text("stdio.txt"), "the stdio line");
+  EXPECT_NE(text("spdlog.txt").find("the spdlog line"), std::string::npos) << text("spdlog.txt");
+  std::filesystem::remove_all(dir);
+}
+
+// A participant still open is left to the normal exit, in which Fast DDS
+// deletes it and tells its peers: end_process returns the code.
+TEST(EndProcess, WithAParticipantOpenLeavesTheExitToFastDds) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant p(cfg, "participant_test staying");
+  EXPECT_EQ(end_process(5), 5);
 }
 
 }  // namespace

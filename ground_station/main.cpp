@@ -12,6 +12,7 @@
 
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
+#include "common/participant.hpp"
 #include "common/process.hpp"
 #include "ground_station/compare.hpp"
 #include "ground_station/dds_commander.hpp"
@@ -424,7 +425,7 @@ int main(int argc, char** argv) {
   // normally on it and keep their 0).
   if (stop_requested() && rc != 0 && rc != 2) {
     std::fprintf(stderr, "ddswarm-gs: interrupted\n");
-    return 130;
+    return end_process(130);
   }
-  return rc;
+  return end_process(rc);
 }

@@ -5,11 +5,12 @@
 #include <cstdio>
 
 #include "common/cli_checks.hpp"
+#include "common/participant.hpp"
 #include "common/process.hpp"
 #include "ground_station/recorder.hpp"
 
 int main(int argc, char** argv) {
-  return ddswarm::run_main("ddswarm-replay", [&]() -> int {
+  const int rc = ddswarm::run_main("ddswarm-replay", [&]() -> int {
     CLI::App app{"ddswarm-replay: republish an MCAP recording over DDS"};
     std::string path;
     double rate = 1.0;
@@ -31,4 +32,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "ddswarm-replay: %llu messages published\n", static_cast<unsigned long long>(n));
     return 0;
   });
+  return ddswarm::end_process(rc);
 }

@@ -7,12 +7,13 @@
 
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
+#include "common/participant.hpp"
 #include "common/process.hpp"
 #include "common/shm_clean.hpp"
 #include "sim_server/sim_server.hpp"
 
 int main(int argc, char** argv) {
-  return ddswarm::run_main("ddswarm-sim", [&] {
+  const int rc = ddswarm::run_main("ddswarm-sim", [&] {
     CLI::App app{"ddswarm-sim: steps every quadrotor in Bullet and serves the swarm over DDS"};
     std::string scenario;
     double duration_s = 0;
@@ -73,4 +74,5 @@ int main(int argc, char** argv) {
     }
     return 0;
   });
+  return ddswarm::end_process(rc);
 }
