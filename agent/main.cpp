@@ -14,7 +14,7 @@
 #include "common/process.hpp"
 
 int main(int argc, char** argv) {
-  const int rc = ddswarm::run_main("ddswarm-agent", [&] {
+  const int code = ddswarm::run_main("ddswarm-agent", [&] {
     CLI::App app{"ddswarm-agent: flies one drone by repulsion-attraction and obstacle avoidance"};
     std::string config;
     std::optional<int> id;
@@ -97,5 +97,5 @@ int main(int argc, char** argv) {
     }
     return 0;
   });
-  return ddswarm::end_process(rc);
+  return ddswarm::end_process(code);
 }

@@ -12,11 +12,11 @@
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <bit>
 #include <cstdio>
 #include <cstdlib>
-#include <iostream>
-#include <bit>
 #include <filesystem>
+#include <iostream>
 #include <mutex>
 #include <optional>
 

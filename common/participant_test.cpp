@@ -385,7 +385,9 @@ TEST(Participant, NoVolatileReaderUsesDataSharingWhateverTheProfileSays) {
   cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
   const ReaderKinds k = state_reader_kinds(cfg);
   EXPECT_EQ(k.durability, fdds::TRANSIENT_LOCAL_DURABILITY_QOS);
-  if (k.shared_memory) EXPECT_NE(k.sharing, fdds::DataSharingKind::OFF);  // never in TSan builds
+  if (k.shared_memory) {  // never in TSan builds
+    EXPECT_NE(k.sharing, fdds::DataSharingKind::OFF);
+  }
 }
 
 // Readers made and removed under a writer that writes throughout must all

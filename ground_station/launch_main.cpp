@@ -73,7 +73,7 @@ int run_foreground(const std::vector<std::string>& argv, Launcher& procs,
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int rc = run_main("ddswarm-launch", [&]() -> int {
+  const int code = run_main("ddswarm-launch", [&]() -> int {
     CLI::App app{"ddswarm-launch: start the server and one agent process per drone"};
     std::string scenario, only = "all", ids_text, on_death = "stop", gs_script, log_dir;
     std::optional<int> drones;
@@ -329,5 +329,5 @@ int main(int argc, char** argv) {
     if (rc != 0) return 1;
     return death_policy.stop() ? 1 : 0;
   });
-  return ddswarm::end_process(rc);
+  return ddswarm::end_process(code);
 }

@@ -12,7 +12,7 @@
 #include "ground_station/recorder.hpp"
 
 int main(int argc, char** argv) {
-  const int rc = ddswarm::run_main("ddswarm-record", [&]() -> int {
+  const int code = ddswarm::run_main("ddswarm-record", [&]() -> int {
     CLI::App app{"ddswarm-record: record every ddswarm topic (or some) to MCAP"};
     ddswarm::gs::RecorderOptions opt;
     double duration_s = 0;
@@ -71,5 +71,5 @@ int main(int argc, char** argv) {
           counts.rejoins, static_cast<unsigned long long>(counts.duplicates));
     return 0;
   });
-  return ddswarm::end_process(rc);
+  return ddswarm::end_process(code);
 }

@@ -13,7 +13,7 @@
 #include "sim_server/sim_server.hpp"
 
 int main(int argc, char** argv) {
-  const int rc = ddswarm::run_main("ddswarm-sim", [&] {
+  const int code = ddswarm::run_main("ddswarm-sim", [&] {
     CLI::App app{"ddswarm-sim: steps every quadrotor in Bullet and serves the swarm over DDS"};
     std::string scenario;
     double duration_s = 0;
@@ -74,5 +74,5 @@ int main(int argc, char** argv) {
     }
     return 0;
   });
-  return ddswarm::end_process(rc);
+  return ddswarm::end_process(code);
 }
