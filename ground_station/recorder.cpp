@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <functional>
@@ -15,6 +16,7 @@
 #include <set>
 #include <span>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -254,6 +256,11 @@ std::string describe_recording(const std::string& path, bool messages) {
   return out;
 }
 
+double replay_rate(double asked, double peak_per_s) {
+  if (!(asked > 1) || !(peak_per_s * asked > kReplayMaxSamplesPerS)) return asked;
+  return std::max(1.0, kReplayMaxSamplesPerS / peak_per_s);
+}
+
 std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double rate, bool loop,
                      const std::vector<std::string>& topics) {
   if (!(rate > 0)) throw std::invalid_argument("--rate must be > 0");
@@ -269,11 +276,15 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
   });
   // One publisher per recorded channel whose topic ddswarm knows.
   std::map<std::uint16_t, std::function<void(std::span<const std::uint8_t>)>> publish;
+  // Channels whose readers may take samples by data-sharing: every topic but
+  // the velocity commands, whose readers are VOLATILE (config/dds_profiles.xml).
+  std::set<std::uint16_t> shared;
   for (const auto& [id, ch] : r.channels()) {
     if (!topics.empty() && std::find(topics.begin(), topics.end(), ch.topic) == topics.end()) continue;
     for_each_topic_type([&, id = id, &ch = ch]<class T>() {  // clang 14 cannot capture a structured binding
       if (ch.topic != Topic<T>::name) return;
       auto w = std::make_shared<Writer<T>>(dds.writer<T>());
+      if (std::string_view(Topic<T>::profile) != "command") shared.insert(id);
       publish[id] = [w](std::span<const std::uint8_t> bytes) {
         typename Topic<T>::PubSub type;
         eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
@@ -293,6 +304,22 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
         fmt::format("a live server (instance {:016x}) is on DDS domain {}: its swarm would fly the "
                     "recording's missions and commands; replay on another domain (--domain)",
                     *live_server, dds_cfg.domain_id));
+  if (rate > 1) {  // faster than recorded: held by the busiest such topic's busiest second
+    std::map<std::pair<std::uint16_t, std::uint64_t>, std::uint64_t> per_second;
+    std::uint64_t peak = 0;
+    r.for_each_message([&](const mcap::MessageView& m) {
+      if (shared.count(m.channel_id))
+        peak = std::max(peak, ++per_second[{m.channel_id, m.log_time_ns / 1'000'000'000}]);
+    });
+    const double asked = rate;
+    rate = replay_rate(asked, static_cast<double>(peak));
+    if (rate != asked)
+      std::fprintf(stderr,
+                   "ddswarm-replay: --rate %g held to %.3g: at %g one topic would be written "
+                   "%.0f times a second, and Fast DDS 2.9.1 may crash a reader that joins a "
+                   "writer that fast (docs/dds.md)\n",
+                   asked, rate, asked, static_cast<double>(peak) * asked);
+  }
   std::uint64_t sent = 0;
   do {
     const auto start = std::chrono::steady_clock::now();

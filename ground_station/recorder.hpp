@@ -56,8 +56,22 @@ class Recorder {
 /// messages, one line per message: log time (ns), topic, bytes, FNV-1a hash of the payload.
 std::string describe_recording(const std::string& path, bool messages = false);
 
+/// The most samples a second a replay writes of one topic that joining
+/// readers may take by data-sharing, when asked to play faster than
+/// recorded: Fast DDS 2.9.1 may crash such a reader when the writer writes
+/// 100,000+ samples a second; 10,000 a second never did in any trial, and is
+/// over three times the most ddswarm publishes (docs/dds.md).
+inline constexpr double kReplayMaxSamplesPerS = 10000;
+
+/// The rate a replay runs at: asked, unless asked > 1 would write a topic
+/// whose peak (its most samples in one second of the recording) is
+/// peak_per_s faster than kReplayMaxSamplesPerS; then the highest rate that
+/// does not, but never under 1, the pace the recording ran at live.
+double replay_rate(double asked, double peak_per_s);
+
 /// Republishes a recording with its original timing scaled by rate (> 0);
 /// loops when asked, until stop_requested(). Returns messages published.
+/// A rate that replay_rate holds is said on stderr, with the rate it runs at.
 /// Throws, before publishing anything, when a live server's scene is on the domain.
 std::uint64_t replay(const DdsConfig& dds, const std::string& path, double rate, bool loop,
                      const std::vector<std::string>& topics);

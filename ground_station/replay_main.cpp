@@ -10,7 +10,7 @@
 #include "ground_station/recorder.hpp"
 
 int main(int argc, char** argv) {
-  const int rc = ddswarm::run_main("ddswarm-replay", [&]() -> int {
+  const int code = ddswarm::run_main("ddswarm-replay", [&]() -> int {
     CLI::App app{"ddswarm-replay: republish an MCAP recording over DDS"};
     std::string path;
     double rate = 1.0;
@@ -18,7 +18,10 @@ int main(int argc, char** argv) {
     std::vector<std::string> topics;
     ddswarm::DdsConfig dds;
     app.add_option("file", path, "recording")->required();
-    app.add_option("--rate", rate, "playback speed (2 = twice as fast)")->check(ddswarm::finite_positive());
+    app.add_option("--rate", rate,
+                   "playback speed (2 = twice as fast; above 1 held so that no topic but the "
+                   "commands is written over 10,000 times a second: docs/dds.md)")
+        ->check(ddswarm::finite_positive());
     app.add_flag("--loop", loop, "start again at the end, until Ctrl-C");
     app.add_option("--topics", topics, "topics to replay (default: all)")->delimiter(',');
     ddswarm::add_dds_options(app, dds);
@@ -32,5 +35,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "ddswarm-replay: %llu messages published\n", static_cast<unsigned long long>(n));
     return 0;
   });
-  return ddswarm::end_process(rc);
+  return ddswarm::end_process(code);
 }
