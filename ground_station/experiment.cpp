@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -270,19 +271,23 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       // its lease timer for that peer fires aborts (kOneShotLeaseS, docs/dds.md).
       std::optional<DdsCommander> commander(std::in_place, opt.gs, dds);
       DdsCommander& gs = *commander;
-      // The sim-time limit per run: the task fails after cfg.timeout_s of sim time.
-      std::atomic<bool> finished{false};
+      // The run's end, set under watch_mu and told on watch_cv, so that the
+      // watchdog's 100 ms wait ends at once (it held every run up to 100 ms).
+      bool finished = false;
+      std::mutex watch_mu;
+      std::condition_variable watch_cv;
       // A process that ends during the run fails it (rec.ok below); one that
       // ends before the swarm is up also ends the wait for it, which would
       // otherwise last a minute.
       std::atomic<bool> someone_died{false};
       std::thread watchdog([&] {
+        std::unique_lock<std::mutex> lock(watch_mu);
         while (!finished && !stop_requested()) {
           for (const auto& e : procs.reap()) {
             died += (died.empty() ? "" : "; ") + e.describe();
             someone_died = true;
           }
-          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          watch_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return finished; });
         }
       });
       const auto give_up = [&] { return someone_died.load(); };
@@ -294,7 +299,11 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       o = up ? fly_task(gs, rec.drones, p.task, nullptr, give_up)
              : swarm_not_up(gs, rec.drones, kSwarmWaitS, give_up);
       times.flight_s = wall_seconds() - flight_start;
-      finished = true;
+      {
+        std::lock_guard<std::mutex> lock(watch_mu);
+        finished = true;
+      }
+      watch_cv.notify_all();
       watchdog.join();
       const double stop_start = wall_seconds();
       commander.reset();

@@ -16,4 +16,8 @@ double SwarmSilence::limit(double now_s, double newest_heard_s, double agent_tim
   return t;
 }
 
+bool declare_lost_now(int past_limit, double longest_silence_s, double limit_s) {
+  return past_limit <= 1 || longest_silence_s > limit_s + kPortLockTimeoutS;
+}
+
 }  // namespace ddswarm::sim

@@ -44,4 +44,20 @@ class SwarmSilence {
   double heard_again_s_ = -1e300;  ///< when the last swarm-wide silence ended
 };
 
+/// How long Fast DDS 2.9 waits for an interprocess lock before it gives up
+/// (BOOST_INTERPROCESS_TIMEOUT_WHEN_LOCKING_DURATION_MS, 1000 ms in its
+/// build): an agent killed while it held the lock of the server's
+/// shared-memory port stalls every other agent's writes to it that long.
+constexpr double kPortLockTimeoutS = 1.0;
+
+/// Whether the agents past their silence limit at one check are declared
+/// lost now: past_limit of them, the longest silent for longest_silence_s.
+/// One alone is. Several at once are most likely one cause, their writes
+/// stalled behind a killed agent's lock on the server's port, not as many
+/// deaths: they wait until the longest silence passes the limit by
+/// kPortLockTimeoutS. In mp_fault_agent_kill (fresh clone, 2026-11-28) four
+/// live agents passed the 1 s limit with the killed one, while a fifth kept
+/// being heard (so the swarm was never silent), and were back 1 ms later.
+bool declare_lost_now(int past_limit, double longest_silence_s, double limit_s);
+
 }  // namespace ddswarm::sim

@@ -52,3 +52,25 @@ TEST(AgentSilence, WithoutAStallADeadAgentIsLostAfterOneTimeout) {
   EXPECT_GT(10.30 - watch.silent_since(9.25), t);
   EXPECT_FALSE(watch.silent());
 }
+
+TEST(AgentSilence, SeveralAgentsPastTheLimitAtOnceWaitOutAPortStall) {
+  // mp_fault_agent_kill, fresh clone of 2026-11-28: agent 3 killed at 9.65;
+  // agent 4 kept being heard, so the swarm was never silent; agents 0, 1, 2,
+  // 3 and 5, last heard at 9.65, passed the 1 s limit together at 10.656,
+  // and all but 3 were heard again at 10.657.
+  SwarmSilence watch;
+  const double t = watch.limit(10.656, 10.40, 1.0);  // agent 4's heartbeat at 10.40
+  EXPECT_DOUBLE_EQ(t, 1.0);
+  EXPECT_FALSE(declare_lost_now(5, 10.656 - 9.65, t)) << "five at once: a stalled port, held";
+  // 10.657: four are back; the killed agent alone is past the limit: lost.
+  EXPECT_TRUE(declare_lost_now(1, 10.657 - 9.65, t));
+  // Five that stay silent (say, an agent-host process killed) are lost one
+  // port-lock timeout later.
+  EXPECT_FALSE(declare_lost_now(5, 1.0 + kPortLockTimeoutS, 1.0));
+  EXPECT_TRUE(declare_lost_now(5, 1.01 + kPortLockTimeoutS, 1.0));
+}
+
+TEST(AgentSilence, OneAgentPastTheLimitIsLostAtOnce) {
+  EXPECT_TRUE(declare_lost_now(1, 1.01, 1.0));
+  EXPECT_TRUE(declare_lost_now(0, 0, 1.0));  // nobody past: nothing to hold
+}

@@ -133,6 +133,7 @@ struct SimServer::Impl {
   bool rival_logged = false;
   std::int64_t scene_published_ns = 0;  // system clock, as the scene's source timestamp
   SwarmSilence swarm_silence;  // expire_agents: whether, and since when, no agent was heard
+  bool holding_lost = false;   // expire_agents: several agents past the limit at once, held
   std::set<std::pair<std::uint64_t, std::uint32_t>> released_missions;  // main thread
   std::uint64_t published_tick = 0;
   // What a ground station waits for changed since the last SimStatus: an
@@ -446,6 +447,23 @@ struct SimServer::Impl {
       spdlog::warn("no agent heard for {:.1f} s: waiting up to {:.1f} s before declaring any lost "
                    "(the silence may be this server's)",
                    now - newest, timeout);
+    int past = 0;
+    double longest = 0;
+    for (const auto& s : slots)
+      if (s.live && now - swarm_silence.silent_since(s.last_heard_wall) > timeout) {
+        ++past;
+        longest = std::max(longest, now - swarm_silence.silent_since(s.last_heard_wall));
+      }
+    if (!declare_lost_now(past, longest, timeout)) {
+      if (!holding_lost)
+        spdlog::warn(
+            "{} agents silent past {:.1f} s at once: waiting up to {:.1f} s more before declaring "
+            "any lost (their writes may be stalled on this server's port)",
+            past, timeout, kPortLockTimeoutS);
+      holding_lost = true;
+      return;
+    }
+    holding_lost = false;
     for (int i = 0; i < n; ++i) {
       Slot& s = slots[i];
       if (s.live && now - swarm_silence.silent_since(s.last_heard_wall) > timeout) {
