@@ -120,15 +120,12 @@ struct DdsCommander::Impl {
     return static_cast<std::size_t>(count >= 0 ? count : sim->num_drones());
   }
 
-  /// The server is heard and count agents are online (count < 0: every drone).
-  bool online_at_least(int count) const { return sim && online_locked().size() >= wanted(count); }
-
   /// The server's own latest status lists count agents live (count < 0:
   /// every drone). A ground station can hear an agent that the server does
   /// not: under load, discovery may have matched the agent with this process
   /// but not yet with the server, and the server releases a mission command
-  /// only to the agents it hears. Implies online_at_least(count): the online
-  /// set includes the server's list.
+  /// only to the agents it hears. The online set (online_locked) includes
+  /// the server's list.
   bool server_hears_at_least(int count) const {
     return sim && sim->live_agents().size() >= wanted(count);
   }
@@ -292,7 +289,10 @@ bool DdsCommander::wait_for_swarm(int count, double timeout_s,
 }
 
 bool DdsCommander::wait_for_online(int count, double timeout_s) {
-  return impl_->wait(timeout_s, [&] { return impl_->online_at_least(count); });
+  // The server's view only: an agent this process hears but the server does
+  // not yet would miss the first ticks of a command sent now, and a lockstep
+  // run with the same seed would fly differently (mp_comm_task, 2026-11-28).
+  return impl_->wait(timeout_s, [&] { return impl_->server_hears_at_least(count); });
 }
 
 bool DdsCommander::wait_for_server(double timeout_s) {

@@ -67,9 +67,9 @@ class DdsCommander final : public Commander {
   /// 100 ms: e.g. a process of the swarm has died).
   bool wait_for_swarm(int count, double timeout_s, const std::function<bool()>& give_up = {});
   /// Waits until the server is heard and count agents are online in its view
-  /// (count < 0: as many as the scenario has), without waiting for this
-  /// process's own connections to each agent: for `wait-agents`, whose
-  /// process exits right after. Returns false on timeout.
+  /// (count < 0: as many as the scenario has), whatever this process hears
+  /// itself, and without waiting for its own connections to each agent: for
+  /// `wait-agents`, whose process exits right after. Returns false on timeout.
   bool wait_for_online(int count, double timeout_s);
   /// Waits until the server's status is heard, the mission writer is matched,
   /// and a heartbeat has arrived from every agent the server hears.

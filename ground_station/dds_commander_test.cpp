@@ -79,13 +79,20 @@ TEST(DdsCommander, WaitsForTheServerToHearEveryAgentNotOnlyItself) {
   swarm.server_hears(5);  // drone 0 matched the ground station, not yet the server
   DdsCommander gs(GroundStationConfig{}, cfg);
 
-  ASSERT_TRUE(gs.wait_for_online(6, 10.0)) << "the ground station never heard the six heartbeats";
+  const double until = wall_seconds() + 10;
+  while (gs.status().drones_online < 6 && wall_seconds() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_EQ(gs.status().drones_online, 6) << "the ground station never heard the six heartbeats";
   EXPECT_FALSE(gs.wait_for_swarm(6, 1.0));
+  // `wait-agents` too: a take-off sent now would reach drone 0 ticks after
+  // the others, and a lockstep run with the same seed would fly differently.
+  EXPECT_FALSE(gs.wait_for_online(6, 1.0));
   const auto st = gs.status();
   EXPECT_EQ(st.drones_online, 6);
   EXPECT_EQ(st.drones_server_hears, 5);
 
   swarm.server_hears(6);
+  EXPECT_TRUE(gs.wait_for_online(6, 10.0));
   EXPECT_TRUE(gs.wait_for_swarm(6, 10.0));
 }
 
