@@ -211,8 +211,7 @@ class Participant {
       // file: Fast DDS 2.9.1 aborts the process when one matches a writer
       // that writes meanwhile (ReaderPool.hpp:141, docs/dds.md). The swarm
       // state's readers are transient-local instead (config/dds_profiles.xml).
-      if (!shared_memory_ || delivery == Delivery::kArchive ||
-          q.durability().kind == fdds::VOLATILE_DURABILITY_QOS)
+      if (!shared_memory_ || delivery == Delivery::kArchive || never_shares(q))
         q.data_sharing().off();
       r = sub->create_datareader(topic, q, listener.get());
     }
@@ -221,6 +220,17 @@ class Participant {
     auto& ref = *listener;
     listeners_.push_back(std::move(listener));
     return ref;
+  }
+
+  /// Whether T's profile reads VOLATILE, so that reader() and every other
+  /// process's reader of T never take its samples by data-sharing, the
+  /// delivery a writer's pace can put at risk (docs/dds.md).
+  template <class T>
+  bool profile_never_shares() {
+    fdds::DataReaderQos q;
+    return subscriber_for("")->get_datareader_qos_from_profile(Topic<T>::profile, q) ==
+               ReturnCode_t::RETCODE_OK &&
+           never_shares(q);
   }
 
   /// Deletes a reader made by reader() (waiting for a running callback):
@@ -244,6 +254,10 @@ class Participant {
  private:
   fdds::Publisher* publisher_for(const std::string& partition);
   fdds::Subscriber* subscriber_for(const std::string& partition);
+  /// No VOLATILE reader by data-sharing (reader(), profile_never_shares()).
+  static bool never_shares(const fdds::DataReaderQos& q) {
+    return q.durability().kind == fdds::VOLATILE_DURABILITY_QOS;
+  }
   /// Under DDS Security, why creating an endpoint may fail; empty otherwise.
   std::string refused_hint(const std::string& partition) const;
   template <class T>

@@ -16,7 +16,6 @@
 #include <set>
 #include <span>
 #include <string>
-#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -276,15 +275,15 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
   });
   // One publisher per recorded channel whose topic ddswarm knows.
   std::map<std::uint16_t, std::function<void(std::span<const std::uint8_t>)>> publish;
-  // Channels whose readers may take samples by data-sharing: every topic but
-  // the velocity commands, whose readers are VOLATILE (config/dds_profiles.xml).
+  // Channels whose readers may take samples by data-sharing (with the shipped
+  // profiles, every topic but the velocity commands, which are read VOLATILE).
   std::set<std::uint16_t> shared;
   for (const auto& [id, ch] : r.channels()) {
     if (!topics.empty() && std::find(topics.begin(), topics.end(), ch.topic) == topics.end()) continue;
     for_each_topic_type([&, id = id, &ch = ch]<class T>() {  // clang 14 cannot capture a structured binding
       if (ch.topic != Topic<T>::name) return;
       auto w = std::make_shared<Writer<T>>(dds.writer<T>());
-      if (std::string_view(Topic<T>::profile) != "command") shared.insert(id);
+      if (!dds.profile_never_shares<T>()) shared.insert(id);
       publish[id] = [w](std::span<const std::uint8_t> bytes) {
         typename Topic<T>::PubSub type;
         eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
