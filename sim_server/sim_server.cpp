@@ -447,12 +447,14 @@ struct SimServer::Impl {
       spdlog::warn("no agent heard for {:.1f} s: waiting up to {:.1f} s before declaring any lost "
                    "(the silence may be this server's)",
                    now - newest, timeout);
+    // A live agent's silence as this check counts it (SwarmSilence).
+    auto silence = [&](const Slot& s) { return now - swarm_silence.silent_since(s.last_heard_wall); };
     int past = 0;
     double longest = 0;
     for (const auto& s : slots)
-      if (s.live && now - swarm_silence.silent_since(s.last_heard_wall) > timeout) {
+      if (s.live && silence(s) > timeout) {
         ++past;
-        longest = std::max(longest, now - swarm_silence.silent_since(s.last_heard_wall));
+        longest = std::max(longest, silence(s));
       }
     if (!declare_lost_now(past, longest, timeout)) {
       if (!holding_lost)
@@ -466,7 +468,7 @@ struct SimServer::Impl {
     holding_lost = false;
     for (int i = 0; i < n; ++i) {
       Slot& s = slots[i];
-      if (s.live && now - swarm_silence.silent_since(s.last_heard_wall) > timeout) {
+      if (s.live && silence(s) > timeout) {
         s.live = false;
         s.owner = 0;
         if (!s.answered) --unanswered;
