@@ -275,8 +275,9 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
   });
   // One publisher per recorded channel whose topic ddswarm knows.
   std::map<std::uint16_t, std::function<void(std::span<const std::uint8_t>)>> publish;
-  // Channels whose readers may take samples by data-sharing (with the shipped
-  // profiles, every topic but the velocity commands, which are read VOLATILE).
+  // Channels whose readers may take samples by data-sharing: those whose
+  // profile does not read them VOLATILE (with the shipped profiles, the
+  // transient-local ones: the swarm state, scene, status, missions, acks).
   std::set<std::uint16_t> shared;
   for (const auto& [id, ch] : r.channels()) {
     if (!topics.empty() && std::find(topics.begin(), topics.end(), ch.topic) == topics.end()) continue;

@@ -19,8 +19,8 @@ int main(int argc, char** argv) {
     ddswarm::DdsConfig dds;
     app.add_option("file", path, "recording")->required();
     app.add_option("--rate", rate,
-                   "playback speed (2 = twice as fast; above 1 held so that no topic but the "
-                   "commands is written over 10,000 times a second: docs/dds.md)")
+                   "playback speed (2 = twice as fast; above 1 held so that no topic read by "
+                   "data-sharing is written over 10,000 times a second: docs/dds.md)")
         ->check(ddswarm::finite_positive());
     app.add_flag("--loop", loop, "start again at the end, until Ctrl-C");
     app.add_option("--topics", topics, "topics to replay (default: all)")->delimiter(',');
