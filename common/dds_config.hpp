@@ -76,6 +76,9 @@ constexpr std::uint32_t kShmSegmentBytes = 4u << 20;
 /// (docs/performance.md).
 std::uint32_t agent_shm_segment_bytes(std::size_t drones);
 
+/// dds.shm_health_check_s's default (see there).
+constexpr double kShmHealthCheckS = 10.0;
+
 struct DdsConfig {
   int domain_id = 0;                  ///< DDS domain, [0, 232]
   Discovery discovery = Discovery::kLocalhost;
@@ -94,6 +97,16 @@ struct DdsConfig {
   int participant_id = -1;            ///< RTPS participant id, -1 = automatic; set explicitly past ~100 participants per host
                                       ///< (at most max_participant_id(domain_id): the RTPS ports must fit)
   double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement
+  /// s: how long a process may stall while it waits on a shared-memory port
+  /// before the processes that send to it find the port broken and make it
+  /// anew (Fast DDS's healthy_check_timeout, 1 s by default). Fast DDS 2.9
+  /// makes ports anew with races that can leave a live process listening on
+  /// a port no sender reaches any more (docs/dds.md), so ddswarm keeps stalls
+  /// shorter than this (a starved CI machine, a server stopped 8 s) off that
+  /// path. The price: a process killed while it waited is found dead this
+  /// much later, and the first process to open its port meanwhile waits up
+  /// to this long.
+  double shm_health_check_s = kShmHealthCheckS;
   /// s between this participant's announcements, < lease; 0: a third of the
   /// lease. Set by the binary (one_shot), not read from YAML.
   double announcement_period_s = 0.0;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -100,6 +101,22 @@ TEST(DdsConfigSecurity, DefaultRoleKeepsTheUsersChoice) {
   default_security_role(c, "gs");
   EXPECT_EQ(c.security_role, "server");
   EXPECT_EQ(drone_partition(7), "drone/7");
+}
+
+TEST(DdsConfig, ShmHealthCheckOutOfRangeIsNamed) {
+  DdsConfig c;
+  EXPECT_EQ(c.shm_health_check_s, kShmHealthCheckS);
+  for (double bad : {0.0, 0.05, 61.0, std::nan("")}) {
+    c.shm_health_check_s = bad;
+    try {
+      c.validate();
+      FAIL() << "dds.shm_health_check_s = " << bad << " accepted";
+    } catch (const FieldError& e) {
+      EXPECT_EQ(e.field(), "dds.shm_health_check_s");
+    }
+  }
+  c.shm_health_check_s = 0.1;
+  EXPECT_NO_THROW(c.validate());
 }
 
 }  // namespace

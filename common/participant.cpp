@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <bit>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -32,11 +33,28 @@ constexpr const char* kLoopback = "127.0.0.1";
 /// Participant ids 0..kInitialPeersRange-1 get unicast discovery pings.
 constexpr int kInitialPeersRange = 120;
 
+/// DDSWARM_FASTDDS_LOG=error|warning|info: how much of Fast DDS's own log a
+/// process prints (to stdout; Fast DDS's default is errors only). Its
+/// warnings name what its transports do on their own, such as a shared-memory
+/// port found unhealthy and made anew (docs/dds.md).
+void apply_fastdds_log_env() {
+  using eprosima::fastdds::dds::Log;
+  const char* v = std::getenv("DDSWARM_FASTDDS_LOG");
+  if (!v || !*v) return;
+  const std::string s = v;
+  if (s == "error") Log::SetVerbosity(Log::Error);
+  else if (s == "warning") Log::SetVerbosity(Log::Warning);
+  else if (s == "info") Log::SetVerbosity(Log::Info);
+  else
+    throw DdsError("DDSWARM_FASTDDS_LOG: '" + s + "' is not one of error, warning, info");
+}
+
 void load_profiles_once(const std::string& file) {
   static std::mutex mu;
   static std::string loaded;
   std::lock_guard<std::mutex> lock(mu);
   if (loaded == file) return;
+  if (loaded.empty()) apply_fastdds_log_env();
   auto rc = fdds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file);
   if (rc != ReturnCode_t::RETCODE_OK) throw DdsError("cannot load DDS QoS profiles from " + file);
   // Participants of one process talk through their transports, as those of
@@ -163,6 +181,7 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
   if (uses_shm_transport(cfg)) {
     auto shm = std::make_shared<SharedMemTransportDescriptor>();
     shm->segment_size(cfg.shm_segment_bytes);
+    shm->healthy_check_timeout_ms(static_cast<uint32_t>(std::lround(cfg.shm_health_check_s * 1000.0)));
     qos.transport().user_transports.push_back(shm);
   }
   qos.transport().user_transports.push_back(udp);

@@ -44,6 +44,14 @@ expect_usage_error "gs experiment --set a bad rate" "set 'Slow': ddswarm-sim: er
 expect_usage_error "gs experiment --set an unknown agent key" "set 'Slow': ddswarm-agent: error:" \
   gs experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$WORK/exp-bad" --set agent.no_such_key=1
 [ ! -e "$WORK/exp-bad/short.csv" ] || problems+=("experiment with a bad set ran runs anyway")
+# A bad DDSWARM_FASTDDS_LOG (docs/dds.md) is named, before any DDS wait.
+t0=$SECONDS
+out=$(DDSWARM_FASTDDS_LOG=loud timeout 10 "$BIN/ddswarm-gs" --domain "$DOMAIN" status 2>&1)
+rc=$?
+echo "DDSWARM_FASTDDS_LOG=loud: exit $rc after $((SECONDS - t0)) s: $out"
+{ [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ $((SECONDS - t0)) -le 3 ] &&
+  echo "$out" | grep -qF "DDSWARM_FASTDDS_LOG: 'loud' is not one of error, warning, info"; } ||
+  problems+=("DDSWARM_FASTDDS_LOG=loud: exit $rc, '$out'")
 for b in sim agent; do
   flag=--scenario; [ $b = agent ] && flag=--config
   out=$(timeout 5 "$BIN/ddswarm-$b" --check $flag "$SRC/config/thesis_course.yaml" 2>&1)

@@ -102,3 +102,14 @@ for spec in sys.argv[3:]:
 open(sys.argv[2], "w").write(xml)
 PY
 }
+
+# shm_ports PID...: the Fast DDS shared-memory ports each process maps. A
+# port listed "(deleted)" was removed and made anew by another process while
+# this one still used it: peers that open it now reach the new one, not this
+# process (docs/dds.md, "A live port found unhealthy").
+shm_ports() {
+  for pid in "$@"; do
+    echo "-- pid $pid ($(tr '\0' ' ' </proc/"$pid"/cmdline 2>/dev/null | cut -c1-60)):"
+    grep -o '/dev/shm/fastrtps_port[0-9]*\( (deleted)\)\?' /proc/"$pid"/maps 2>/dev/null | sort -u
+  done
+}
