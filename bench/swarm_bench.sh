@@ -241,6 +241,17 @@ run_swarm() {
   LAUNCH_PID=""
   # Drone-drone contacts begun in the whole run (take-off included): the sim logs each one.
   local contacts; contacts=$(grep -c "collision: drone [0-9]* with drone" "$log/sim.log" 2>/dev/null)
+  # A failed run's logs, kept before the next run of the same N reuses its directory.
+  if [ -n "$why" ]; then
+    {
+      echo "===== $mode N=$n$RUN_TAG ${SETS[*]} ${RUN_EXTRA[*]}: $why"
+      for f in "$log"/*.log "$log"/*.err "$log"/*.out; do
+        [ -s "$f" ] || continue
+        echo "----- ${f##*/} (last 40 lines) -----"
+        tail -n 40 "$f"
+      done
+    } >>"$OUT/failed_runs.log"
+  fi
   echo "mode=$mode n=$n up_s=$up ds=${addr:-none} contacts=${contacts:-0} why=\"$why\" $line"
 }
 
@@ -432,4 +443,8 @@ if ! skip table1; then
   echo
   echo "== Table 1: 4 sets x $T1_RUNS lockstep runs of the six-drone task, $STREAMS state and commands, $T1_JOBS at a time (exit $rc, load $(cut -d' ' -f1 /proc/loadavg)) =="
   $PY "$SRC/bench/table1_split.py" "$T1/out" "$total"
+fi
+if [ -s "$OUT/failed_runs.log" ]; then
+  echo
+  echo "swarm_bench: $(grep -c '^===== ' "$OUT/failed_runs.log") swarm run(s) failed; their logs: $OUT/failed_runs.log"
 fi

@@ -6,6 +6,8 @@ source "$(dirname "$0")/lib.sh"
 start bench bash "$SRC/bench/swarm_bench.sh" --bin "$BIN" --quick --sizes 3 --physics "1000 250" --out "$WORK/out"
 wait_pid "$PID_bench" 400; rc=$?
 out="$WORK/bench.log"
+# On failure, the logs of every swarm run that failed (swarm_bench keeps them).
+fail() { cat "$WORK/out/failed_runs.log" 2>/dev/null; echo "FAIL: $*"; exit 1; }
 [ $rc -eq 0 ] || fail "swarm_bench exit $rc"
 for title in "bare Fast DDS lockstep floor" "== lockstep:" "== real time:" "== Table 1:"; do
   grep -q -- "$title" "$out" || fail "no '$title' table"
