@@ -127,9 +127,15 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
 }
 
 int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir, int first_id) {
+  // A port file, or its owner's lock without the file: a live process whose
+  // port Fast DDS removed and never made anew (a sender's "Zombie. Reset the
+  // port" after a stall) still listens there, and a newcomer on that id could
+  // not take its lock: it came up without ports and never heard a scene
+  // (docs/dds.md).
   auto held = [&](int port) {
+    const std::string path = dir + "/fastrtps_port" + std::to_string(port);
     struct stat st;
-    return stat((dir + "/fastrtps_port" + std::to_string(port)).c_str(), &st) == 0;
+    return stat(path.c_str(), &st) == 0 || locked(path + "_el", false);
   };
   for (int id = first_id; id <= max_id; ++id) {
     const int meta = rtps_unicast_port(domain_id, id);

@@ -32,7 +32,8 @@ ShmCleanReport clean_zombie_shm(const std::string& dir = "/dev/shm");
 /// (a killed server) is still mapped by the processes that sent to it, and
 /// Fast DDS 2.9 keeps them writing into it after a new process re-creates the
 /// port under the same name: nothing they send reaches the newcomer
-/// (docs/dds.md). A newcomer on a clear id gets ports nobody holds.
+/// (docs/dds.md). A newcomer on a clear id gets ports nobody holds. A port
+/// whose file is gone while its owner still holds its "_el" lock is held too.
 int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir = "/dev/shm",
                                 int first_id = 0);
 

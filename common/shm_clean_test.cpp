@@ -127,6 +127,26 @@ TEST(ShmClean, ParticipantIdClearOfPortsADeadProcessLeft) {
   EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path, 3), 3);
 }
 
+// A live participant whose port file was removed (Fast DDS 2.9 made it anew
+// and removed it again after a stall) still holds its port's lock: a
+// newcomer on that id could not take the lock, came up without ports and
+// never heard the scene. A lock file nobody holds (its owner died) does not count.
+TEST(ShmClean, ParticipantIdClearOfALiveOwnerWhosePortFileWasRemoved) {
+  using ddswarm::participant_id_clear_of_shm;
+  using ddswarm::rtps_unicast_port;
+  TempDir d;
+  const int domain = 43;
+  const std::string el0 = d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain, 0)) + "_el");
+  d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain, 1)) + "_el");  // stale
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path), 0) << "no lock held yet";
+  const int fd = ::open(el0.c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // the live owner's lock
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path), 1);
+  ::close(fd);
+  EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path), 0);
+}
+
 // A domain is in use while a Fast DDS participant of this host is on it
 // (its shared-memory ports are locked), and not after.
 TEST(ShmClean, ALiveParticipantMarksItsDomainInUse) {
