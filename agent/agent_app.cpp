@@ -675,5 +675,9 @@ struct AgentApp::Impl {
 AgentApp::AgentApp(AgentAppConfig cfg) : impl_(std::make_unique<Impl>(std::move(cfg))) {}
 AgentApp::~AgentApp() = default;
 AgentApp::End AgentApp::run(double duration_s) { return impl_->run(duration_s); }
+bool AgentApp::heard_scene() const {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->scene.has_value();
+}
 
 }  // namespace ddswarm::agent

@@ -53,6 +53,8 @@ class AgentApp {
   /// for twice that lease while the server's scene writer stayed matched:
   /// the caller should destroy this app and join again.
   End run(double duration_s);
+  /// Whether this participant has heard the server's scene.
+  bool heard_scene() const;
 
  private:
   struct Impl;
