@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
       // or this process outlived its DDS lease (stopped or starved).
       // Each join that heard no scene waits twice as long as the one before
       // (rejoin_patience_s): a swarm whose discovery is slow still comes up.
-      // A join after one that had the scene (the swarm is up) waits at most
+      // A join right after one that had the scene (the swarm is up) waits at most
       // kRejoinedSceneLeases leases for it. If it comes in neither that
       // time, or the server did not hear this agent, or this agent did not
       // hear the server, every later join leaves the shared-memory transport
@@ -108,12 +108,13 @@ int main(int argc, char** argv) {
         no_scene = end == AgentApp::End::kNoScene ? no_scene + 1 : 0;
         const bool cut_off = end == AgentApp::End::kUnheard || end == AgentApp::End::kDeaf ||
                              (rejoined_swarm && end == AgentApp::End::kNoScene);
-        had_scene = had_scene || agent.heard_scene();
+        // For the next join only: a server that is gone is waited for as before.
+        had_scene = agent.heard_scene();
         if (cut_off && !without_shm && join.dds.shared_memory && join.dds.shm_transport) {
           without_shm = true;
-          spdlog::warn("ddswarm-agent: joining again without the shared-memory transport (UDP on "
-                       "127.0.0.1; the swarm state still by data-sharing): the server may listen on "
-                       "shared-memory ports no new sender reaches (docs/dds.md)");
+          spdlog::warn("ddswarm-agent: joining again without the shared-memory transport (UDP "
+                       "on 127.0.0.1; the swarm state still by data-sharing): the server may "
+                       "listen on shared-memory ports no new sender reaches (docs/dds.md)");
         }
         return end != AgentApp::End::kStopped;
       });

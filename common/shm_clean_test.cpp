@@ -136,7 +136,8 @@ TEST(ShmClean, ParticipantIdClearOfALiveOwnerWhosePortFileWasRemoved) {
   using ddswarm::rtps_unicast_port;
   TempDir d;
   const int domain = 43;
-  const std::string el0 = d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain, 0)) + "_el");
+  const std::string el0 =
+      d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain, 0)) + "_el");
   d.touch("fastrtps_port" + std::to_string(rtps_unicast_port(domain, 1)) + "_el");  // stale
   EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path), 0) << "no lock held yet";
   const int fd = ::open(el0.c_str(), O_RDONLY | O_CLOEXEC);
