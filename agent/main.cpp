@@ -2,13 +2,12 @@
 // --ids, an agent host flying many drones' independent brains in one process.
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
-
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <optional>
 
 #include "agent/agent_app.hpp"
+#include "agent/rejoin_policy.hpp"
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
 #include "common/id_ranges.hpp"
@@ -81,41 +80,22 @@ int main(int argc, char** argv) {
     try {
       using ddswarm::agent::AgentApp;
       // A new participant each time no scene came (agent.rejoin_after_s), SIGUSR1 asked for one,
-      // or this process outlived its DDS lease (stopped or starved).
-      // Each join that heard no scene waits twice as long as the one before
-      // (rejoin_patience_s): a swarm whose discovery is slow still comes up.
-      // A join right after one that had the scene (the swarm is up) waits at most
-      // kRejoinedSceneLeases leases for it. If it comes in neither that
-      // time, or the server did not hear this agent, or this agent did not
-      // hear the server, every later join leaves the shared-memory transport
-      // out and talks UDP on 127.0.0.1 (the swarm state still comes by
-      // data-sharing): Fast DDS 2.9 can leave the server listening on
-      // shared-memory ports whose files a stall made anew and removed, which
-      // no new sender reaches (docs/dds.md, docs/faults.md).
-      constexpr double kRejoinedSceneLeases = 4.0;
-      int no_scene = 0;
-      bool had_scene = false, without_shm = false;
+      // this process outlived its DDS lease (stopped or starved), the server did not hear it or
+      // it did not hear the server. RejoinPolicy sets each join's scene wait and, once this
+      // agent was cut off, leaves the shared-memory transport out (docs/faults.md).
+      ddswarm::agent::RejoinPolicy policy(cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
+                                          cfg.dds.shared_memory && cfg.dds.shm_transport);
       ddswarm::keep_joining(duration_s, [&](double left) {
         auto join = cfg;  // the user's configuration stays as given
-        join.agent.rejoin_after_s = ddswarm::rejoin_patience_s(cfg.agent.rejoin_after_s, no_scene);
-        const bool rejoined_swarm = had_scene && join.agent.rejoin_after_s > 0;
-        if (rejoined_swarm)
-          join.agent.rejoin_after_s =
-              std::min(join.agent.rejoin_after_s, kRejoinedSceneLeases * cfg.dds.lease_duration_s);
-        if (without_shm) join.dds.shm_transport = false;
+        join.agent.rejoin_after_s = policy.scene_wait_s();
+        if (!policy.shm_transport()) join.dds.shm_transport = false;
         AgentApp agent(join);
         const auto end = agent.run(left);
-        no_scene = end == AgentApp::End::kNoScene ? no_scene + 1 : 0;
-        const bool cut_off = end == AgentApp::End::kUnheard || end == AgentApp::End::kDeaf ||
-                             (rejoined_swarm && end == AgentApp::End::kNoScene);
-        // For the next join only: a server that is gone is waited for as before.
-        had_scene = agent.heard_scene();
-        if (cut_off && !without_shm && join.dds.shared_memory && join.dds.shm_transport) {
-          without_shm = true;
+        const bool cut_off = end == AgentApp::End::kUnheard || end == AgentApp::End::kDeaf;
+        if (policy.ended(cut_off, end == AgentApp::End::kNoScene, agent.heard_scene()))
           spdlog::warn("ddswarm-agent: joining again without the shared-memory transport (UDP "
                        "on 127.0.0.1; the swarm state still by data-sharing): the server may "
                        "listen on shared-memory ports no new sender reaches (docs/dds.md)");
-        }
         return end != AgentApp::End::kStopped;
       });
     } catch (const ddswarm::agent::DuplicateAgent& e) {

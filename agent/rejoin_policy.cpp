@@ -1,0 +1,25 @@
+#include "agent/rejoin_policy.hpp"
+
+#include "common/process.hpp"
+
+#include <algorithm>
+
+namespace ddswarm::agent {
+
+double RejoinPolicy::scene_wait_s() const {
+  const double wait = rejoin_patience_s(rejoin_after_s_, no_scene_);
+  if (had_scene_ && wait > 0) return std::min(wait, kRejoinedSceneLeases * lease_s_);
+  return wait;
+}
+
+bool RejoinPolicy::ended(bool cut_off, bool no_scene, bool heard_scene) {
+  const bool rejoined_swarm = had_scene_ && rejoin_after_s_ > 0;
+  const bool lost = cut_off || (rejoined_swarm && no_scene);
+  no_scene_ = no_scene ? no_scene_ + 1 : 0;
+  had_scene_ = heard_scene;
+  if (!lost || !shm_) return false;
+  shm_ = false;
+  return true;
+}
+
+}  // namespace ddswarm::agent

@@ -1,0 +1,43 @@
+#pragma once
+// When an agent process joins DDS again, how patient its next participant is
+// for the scene and whether it keeps the shared-memory transport: a pure
+// rule, free of DDS and clocks (agent/main.cpp's join loop applies it).
+
+namespace ddswarm::agent {
+
+class RejoinPolicy {
+ public:
+  /// A join right after one that had the scene (the swarm is up) waits at
+  /// most this many DDS leases for the scene.
+  static constexpr double kRejoinedSceneLeases = 4.0;
+
+  /// rejoin_after_s: agent.rejoin_after_s (0 = never re-join for want of a
+  /// scene); lease_s: dds.lease_duration_s; shm_transport: whether the
+  /// user's configuration uses the shared-memory transport.
+  RejoinPolicy(double rejoin_after_s, double lease_s, bool shm_transport)
+      : rejoin_after_s_(rejoin_after_s), lease_s_(lease_s), shm_(shm_transport) {}
+
+  /// The next join's scene wait (its agent.rejoin_after_s). Each join in a
+  /// row that heard no scene waits twice as long as the one before
+  /// (rejoin_patience_s), except right after a join that had the scene.
+  double scene_wait_s() const;
+  /// Whether the next join uses the shared-memory transport.
+  bool shm_transport() const { return shm_; }
+
+  /// How the join that scene_wait_s() planned ended. cut_off: the server did
+  /// not hear it, or it did not hear the server (kUnheard, kDeaf); no_scene:
+  /// no scene within its wait (kNoScene); heard_scene: it had the scene.
+  /// Returns true when this end turns the shared-memory transport off for
+  /// every later join: Fast DDS 2.9 can leave the server listening on
+  /// shared-memory ports whose files a stall made anew and removed, which
+  /// no new sender reaches, while UDP reaches it (docs/dds.md).
+  bool ended(bool cut_off, bool no_scene, bool heard_scene);
+
+ private:
+  double rejoin_after_s_, lease_s_;
+  bool shm_;
+  int no_scene_ = 0;          ///< joins in a row that heard no scene
+  bool had_scene_ = false;    ///< the last join had the scene
+};
+
+}  // namespace ddswarm::agent

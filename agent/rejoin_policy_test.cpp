@@ -1,0 +1,60 @@
+#include "agent/rejoin_policy.hpp"
+
+#include <gtest/gtest.h>
+
+namespace ddswarm::agent {
+namespace {
+
+// mp_fault_shm_port_removed: the server's port files are gone; agent 2, which
+// had the scene, is asked to join again. Its next participant waits 4 leases,
+// not 40 s, and when no scene comes, every later join talks UDP.
+TEST(RejoinPolicy, AJoinAfterTheSceneThatHearsNoneLeavesSharedMemoryOut) {
+  RejoinPolicy p(40.0, 3.0, true);
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 40.0);
+  EXPECT_FALSE(p.ended(false, false, true));  // SIGUSR1 after flying with the scene
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 12.0);
+  EXPECT_TRUE(p.shm_transport());
+  EXPECT_TRUE(p.ended(false, true, false)) << "no scene right after the swarm was up";
+  EXPECT_FALSE(p.shm_transport());
+  // A server that is gone is then waited for as before: 40 s, doubling.
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 80.0);
+  EXPECT_FALSE(p.ended(false, true, false)) << "said once";
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 160.0);
+  EXPECT_FALSE(p.shm_transport());
+}
+
+// mp_fault_server_freeze in CI: the server did not hear the agent after its
+// stop (kUnheard); the re-joined participant, on shared memory, heard no scene.
+TEST(RejoinPolicy, AnUnheardOrDeafAgentJoinsWithoutSharedMemory) {
+  RejoinPolicy p(40.0, 3.0, true);
+  EXPECT_TRUE(p.ended(true, false, true));
+  EXPECT_FALSE(p.shm_transport());
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 12.0);
+  EXPECT_FALSE(p.ended(true, false, true)) << "said once";
+}
+
+// At start-up (no scene yet) a join that heard none is a slow discovery, not
+// a lost port: it keeps shared memory and waits twice as long each time.
+TEST(RejoinPolicy, NoSceneAtStartUpKeepsSharedMemory) {
+  RejoinPolicy p(40.0, 3.0, true);
+  EXPECT_FALSE(p.ended(false, true, false));
+  EXPECT_TRUE(p.shm_transport());
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 80.0);
+  // Stopped longer than the lease after the scene: the next join waits 4 leases.
+  EXPECT_FALSE(p.ended(false, false, true));
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 12.0);
+}
+
+// Never re-joining for want of a scene (agent.rejoin_after_s 0) stays so, and
+// a configuration without the shared-memory transport has nothing to leave out.
+TEST(RejoinPolicy, ZeroWaitAndNoSharedMemoryStayAsConfigured) {
+  RejoinPolicy never(0.0, 3.0, true);
+  EXPECT_FALSE(never.ended(false, false, true));
+  EXPECT_DOUBLE_EQ(never.scene_wait_s(), 0.0);
+  RejoinPolicy udp(40.0, 3.0, false);
+  EXPECT_FALSE(udp.ended(true, false, true));
+  EXPECT_FALSE(udp.shm_transport());
+}
+
+}  // namespace
+}  // namespace ddswarm::agent
