@@ -37,16 +37,20 @@ constexpr int kInitialPeersRange = 120;
 /// process prints (to stdout; Fast DDS's default is errors only). Its
 /// warnings name what its transports do on their own, such as a shared-memory
 /// port found unhealthy and made anew (docs/dds.md).
+/// Once per process, before its first participant; a bad value throws each time.
 void apply_fastdds_log_env() {
   using eprosima::fastdds::dds::Log;
-  const char* v = std::getenv("DDSWARM_FASTDDS_LOG");
-  if (!v || !*v) return;
-  const std::string s = v;
-  if (s == "error") Log::SetVerbosity(Log::Error);
-  else if (s == "warning") Log::SetVerbosity(Log::Warning);
-  else if (s == "info") Log::SetVerbosity(Log::Info);
-  else
-    throw DdsError("DDSWARM_FASTDDS_LOG: '" + s + "' is not one of error, warning, info");
+  static std::once_flag once;
+  std::call_once(once, [] {
+    const char* v = std::getenv("DDSWARM_FASTDDS_LOG");
+    if (!v || !*v) return;
+    const std::string s = v;
+    if (s == "error") Log::SetVerbosity(Log::Error);
+    else if (s == "warning") Log::SetVerbosity(Log::Warning);
+    else if (s == "info") Log::SetVerbosity(Log::Info);
+    else
+      throw DdsError("DDSWARM_FASTDDS_LOG: '" + s + "' is not one of error, warning, info");
+  });
 }
 
 void load_profiles_once(const std::string& file) {
@@ -54,7 +58,6 @@ void load_profiles_once(const std::string& file) {
   static std::string loaded;
   std::lock_guard<std::mutex> lock(mu);
   if (loaded == file) return;
-  if (loaded.empty()) apply_fastdds_log_env();
   auto rc = fdds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file);
   if (rc != ReturnCode_t::RETCODE_OK) throw DdsError("cannot load DDS QoS profiles from " + file);
   // Participants of one process talk through their transports, as those of
@@ -248,6 +251,7 @@ eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrt
 
 Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   cfg.validate();
+  apply_fastdds_log_env();
   load_profiles_once(cfg.profiles_file);
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   secure_ = cfg.secure();
