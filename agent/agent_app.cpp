@@ -600,8 +600,9 @@ struct AgentApp::Impl {
         return AgentApp::End::kOutlivedLease;
       }
       if (take_rejoin_request()) {
-        spdlog::warn("{}: asked to join again (SIGUSR1: the discovery server dropped this participant's "
-                     "endpoints); leaving DDS and joining again as a new participant",
+        spdlog::warn("{}: asked to join again (SIGUSR1, as ddswarm-launch sends when its discovery "
+                     "server dropped this participant); leaving DDS and joining again as a new "
+                     "participant",
                      label);
         return AgentApp::End::kRejoinRequested;
       }

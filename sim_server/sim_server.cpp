@@ -867,9 +867,9 @@ struct SimServer::Impl {
         .count();
   }
 
-  /// SIGUSR1 (ddswarm-launch: its discovery server dropped this participant's
-  /// endpoints, so no agent will ever match them): leave DDS and start again
-  /// as a new server, but only before any mission command came.
+  /// SIGUSR1 (from a user, or from ddswarm-launch when its discovery server
+  /// dropped this participant's endpoints, so no agent will ever match them):
+  /// leave DDS and start again as a new server, but only before any mission command came.
   bool rejoin_now() {
     if (rival_instance.load() != 0) return true;
     if (!take_rejoin_request()) return false;
@@ -878,8 +878,8 @@ struct SimServer::Impl {
       spdlog::warn("asked to join DDS again (SIGUSR1), but a mission has begun: staying");
       return false;
     }
-    spdlog::warn("asked to join DDS again (SIGUSR1: the discovery server dropped this participant's "
-                 "endpoints); starting again as a new server");
+    spdlog::warn("asked to join DDS again (SIGUSR1, as ddswarm-launch sends when its discovery "
+                 "server dropped this participant); starting again as a new server");
     rejoin = true;
     return true;
   }
