@@ -283,10 +283,12 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
       std::thread watchdog([&] {
         std::unique_lock<std::mutex> lock(watch_mu);
         while (!finished && !stop_requested()) {
+          lock.unlock();  // the run's end is told while this reaps
           for (const auto& e : procs.reap()) {
             died += (died.empty() ? "" : "; ") + e.describe();
             someone_died = true;
           }
+          lock.lock();
           watch_cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return finished; });
         }
       });
