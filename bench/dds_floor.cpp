@@ -15,15 +15,19 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
 #include "bench/bench_util.hpp"
+#include "bench/hover_field.hpp"
 #include "common/participant.hpp"
 #include "common/process.hpp"
+#include "sim_server/sim_server.hpp"
 
 using namespace ddswarm;
 using namespace ddswarm::bench;
@@ -55,6 +59,10 @@ msg::SwarmState make_state(int n) {
 
 std::string g_profiles;  // --profiles: a QoS profiles file other than ddswarm's
 double g_work_us = 0;  // --work-us: the publisher's CPU between ticks, standing in for physics
+// --physics-hz: the publisher steps a lockstep server's physics between ticks;
+// --physics-scenario: whose scene, formation, airframe, controller and sensors.
+double g_physics_hz = 0;
+std::string g_physics_scenario;
 bool g_best_effort = false;  // --best-effort-streams: read the two streams as a real-time swarm does
 Delivery stream_delivery() { return g_best_effort ? Delivery::kLatest : Delivery::kProfile; }
 
@@ -105,7 +113,15 @@ struct Result {
   long ticks = 0;
   double responder_rss_mb = NAN;
   int responder_threads = 0;
+  double physics_us = NAN;  ///< --physics-hz: the publisher's CPU per tick in the physics (µs)
 };
+
+/// CPU seconds this thread has run.
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
 
 double cpu_of(const std::map<pid_t, ProcSample>& m) {
   double s = 0;
@@ -126,6 +142,24 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
   Result r;
   r.n = n;
   r.discovery = use_server ? "server" : "simple";
+  // --physics-hz: what a lockstep server computes between ticks, for N
+  // hovering drones (bench/hover_field.hpp), in place of --work-us's wait.
+  std::optional<bench::HoverField> field;
+  sim::SensorConfig sensors;
+  sensors.count = kRays;
+  sensors.max_range_m = 6.0;
+  int sensor_every = 1;
+  int substeps = static_cast<int>(std::lround(g_physics_hz / 50.0));  // 50 Hz control
+  if (g_physics_hz > 0 && g_physics_scenario.empty()) {
+    field.emplace(n, 1.0 / g_physics_hz);
+  } else if (g_physics_hz > 0) {
+    sim::ServerConfig c = sim::load_server_config(g_physics_scenario);
+    sensors = c.sensors;
+    sensor_every = c.sim.sensor_every();
+    substeps = static_cast<int>(std::lround(g_physics_hz / c.sim.control_rate_hz));
+    field.emplace(c.scene, c.quadrotor, c.controller, c.scene.start_positions(n, c.scenario.seed),
+                  1.0 / g_physics_hz);
+  }
   std::vector<pid_t> kids;
   std::string server;
   const double t0 = wall_seconds();
@@ -188,6 +222,7 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
       // Lockstep; re-publish a tick nobody answered within 0.25 s (a sample
       // written before the match completed is lost for good: FASTDDS_NOTES trap 1).
       long ticks = 0;
+      double physics_cpu_s = 0;  // in the measured window
       bool measuring = false;
       double t_measure = 0;
       std::map<pid_t, ProcSample> cpu0;
@@ -213,6 +248,7 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
           measuring = true;
           t_measure = now;
           ticks = 0;
+          physics_cpu_s = 0;
           cpu0 = sample_all(all);
         } else if (measuring) {
           ++ticks;
@@ -221,9 +257,15 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
             r.busy_cores = cpu_between(cpu0, sample_all(all)) / dt;
             r.ticks = ticks;
             r.ticks_per_s = ticks / dt;
+            if (field && ticks > 0) r.physics_us = physics_cpu_s * 1e6 / static_cast<double>(ticks);
             r.ok = true;
             break;
           }
+        }
+        if (field) {
+          const double c0 = thread_cpu_s();
+          field->server_tick(substeps, sensors, tick % sensor_every == 0);
+          if (measuring) physics_cpu_s += thread_cpu_s() - c0;
         }
         if (g_work_us > 0) {  // busy, as a physics step is: no sleep, no yield
           const double until = wall_seconds() + g_work_us * 1e-6;
@@ -280,6 +322,18 @@ int main(int argc, char** argv) {
                    "µs the publisher spends busy between ticks, as a server steps physics there "
                    "(0: none, the floor)")
         ->check(CLI::NonNegativeNumber);
+    app.add_option(
+           "--physics-hz", g_physics_hz,
+           "step a lockstep server's physics between ticks: N hovering drones' flight "
+           "controllers and Bullet at this rate (Hz) for one 50 Hz tick, then 8 rays of 6 m per "
+           "drone (0: none, the floor). The floor with it is the most plain lockstep can tick "
+           "(its physics CPU per tick is printed)")
+        ->check(CLI::Range(0.0, 4000.0));
+    app.add_option(
+           "--physics-scenario", g_physics_scenario,
+           "with --physics-hz: this scenario's scene, start formation, airframe, controller and "
+           "sensors (default: a field of pillars, 8 rays of 6 m every tick)")
+        ->check(CLI::ExistingFile);
     app.add_flag("--best-effort-streams", g_best_effort,
                  "read the swarm state and the commands best-effort, as ddswarm does by default "
                  "(dds.best_effort_streams; writers stay reliable; a lost tick is re-published after 0.25 s)");
@@ -332,25 +386,41 @@ int main(int argc, char** argv) {
         results.push_back(r);
       }
     }
-    std::printf("\n== bare Fast DDS lockstep floor: 1 publisher of a whole-swarm SwarmState, N responder "
-                "processes; %.0f s warm-up, %.0f s measured ==\n",
-                warmup_s, measure_s);
-    std::printf("| N | discovery | ticks/s | discovery time (s) | idle CPU (cores) | CPU while ticking (cores) | "
-                "responder RSS (MB) | responder threads | note |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|\n");
+    const std::string between =
+        g_physics_hz > 0
+            ? fmt::format("; the publisher steps {:.0f} Hz physics for N drones between ticks",
+                          g_physics_hz)
+        : g_work_us > 0 ? fmt::format("; the publisher busy {:.0f} us between ticks", g_work_us)
+                        : std::string();
+    std::printf(
+        "\n== bare Fast DDS lockstep floor: 1 publisher of a whole-swarm SwarmState, N responder "
+        "processes%s; %.0f s warm-up, %.0f s measured ==\n",
+        between.c_str(), warmup_s, measure_s);
+    std::printf(
+        "| N | discovery | ticks/s | discovery time (s) | idle CPU (cores) | CPU while ticking "
+        "(cores) | "
+        "responder RSS (MB) | responder threads | physics CPU per tick (µs) | note |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
     for (const auto& r : results)
-      std::printf("| %d | %s | %s | %s | %s | %s | %s | %s | %s |\n", r.n, r.discovery.c_str(),
-                  fmt_num(r.ticks_per_s, "{:.0f}").c_str(), fmt_num(r.discovery_s, "{:.1f}").c_str(),
-                  fmt_num(r.idle_cores, "{:.2f}").c_str(), fmt_num(r.busy_cores, "{:.2f}").c_str(),
+      std::printf("| %d | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r.n, r.discovery.c_str(),
+                  fmt_num(r.ticks_per_s, "{:.0f}").c_str(),
+                  fmt_num(r.discovery_s, "{:.1f}").c_str(), fmt_num(r.idle_cores, "{:.2f}").c_str(),
+                  fmt_num(r.busy_cores, "{:.2f}").c_str(),
                   fmt_num(r.responder_rss_mb, "{:.1f}").c_str(),
-                  r.responder_threads ? std::to_string(r.responder_threads).c_str() : "-", r.why.c_str());
+                  r.responder_threads ? std::to_string(r.responder_threads).c_str() : "-",
+                  fmt_num(r.physics_us, "{:.0f}").c_str(), r.why.c_str());
     if (!csv.empty()) {
       bool fresh = !std::filesystem::exists(csv);
       std::ofstream f(csv, std::ios::app);
-      if (fresh) f << "n,discovery,ok,ticks_per_s,discovery_s,idle_cores,busy_cores,responder_rss_mb,note\n";
+      if (fresh)
+        f << "n,discovery,ok,ticks_per_s,discovery_s,idle_cores,busy_cores,responder_rss_mb,note,"
+             "physics_hz,"
+             "work_us,physics_us\n";
       for (const auto& r : results)
-        f << r.n << "," << r.discovery << "," << (r.ok ? 1 : 0) << "," << r.ticks_per_s << "," << r.discovery_s
-          << "," << r.idle_cores << "," << r.busy_cores << "," << r.responder_rss_mb << ",\"" << r.why << "\"\n";
+        f << r.n << "," << r.discovery << "," << (r.ok ? 1 : 0) << "," << r.ticks_per_s << ","
+          << r.discovery_s << "," << r.idle_cores << "," << r.busy_cores << ","
+          << r.responder_rss_mb << ",\"" << r.why << "\"," << g_physics_hz << "," << g_work_us
+          << "," << r.physics_us << "\n";
     }
     bool any_fail = false;
     for (const auto& r : results)

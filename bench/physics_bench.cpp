@@ -10,95 +10,29 @@
 //   us_per_frame  one cast_rays() for every drone
 //   rays_per_s    rays cast per second of wall time
 //   hit_frac      share of rays that hit something
+//   us_per_tick   BM_ServerTick: one 50 Hz control tick of a lockstep server's
+//                 compute (physics_hz / 50 substeps of every drone's flight
+//                 controller and step(), then 8 rays of 6 m per drone)
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cmath>
 #include <random>
-#include <stdexcept>
 #include <vector>
 
-#include "common/scene.hpp"
-#include "sim_server/flight_controller.hpp"
-#include "sim_server/physics_world.hpp"
+#include "bench/hover_field.hpp"
 
 namespace {
 
-using ddswarm::Cylinder;
-using ddswarm::SceneConfig;
+using ddswarm::bench::HoverField;
 using namespace ddswarm::sim;
 using Clock = std::chrono::steady_clock;
 
 constexpr double kDt = 0.001;
 
-/// N drones hovering at 2 m in a 2 m grid laid over a staggered pillar field.
-class HoverField {
- public:
-  explicit HoverField(int n) : world_(make_scene(n), QuadrotorParams{}, grid(n), 0.0) {
-    fc_.reserve(n);
-    for (int i = 0; i < n; ++i) {
-      fc_.emplace_back(QuadrotorParams{}, ControllerConfig{});
-      const Eigen::Vector3d p = world_.state(i).p_world;
-      world_.reset_drone(i, {p.x(), p.y(), 2.0}, 0.0);
-    }
-    sp_.motors_on = true;
-    for (int k = 0; k < 300; ++k) control_and_step();  // spin up and settle
-  }
-
-  void control() {
-    for (int i = 0; i < world_.size(); ++i)
-      world_.set_rotor_commands(i, fc_[i].update(world_.state(i), sp_, kDt));
-  }
-  void control_and_step() {
-    control();
-    world_.step(kDt);
-  }
-  PhysicsWorld& world() { return world_; }
-
- private:
-  static double pillar_clearance(double x, double y) {
-    double best = 1e9;
-    for (int row = -20; row <= 20; ++row)
-      for (int col = -20; col <= 20; ++col) {
-        const double px = col * 8.0 + (row % 2 ? 4.0 : 0.0), py = row * 8.0;
-        best = std::min(best, std::hypot(x - px, y - py));
-      }
-    return best;
-  }
-  /// Grid side (points) that leaves room for n drones between the pillars.
-  static int side_for(int n) { return static_cast<int>(std::ceil(std::sqrt(n * 1.4))) + 2; }
-  /// Points of a 2 m grid, row by row, at least 2 m from every pillar axis.
-  static std::vector<Eigen::Vector3d> grid(int n) {
-    std::vector<Eigen::Vector3d> out;
-    const int side = side_for(n);
-    for (int j = 0; j < side && static_cast<int>(out.size()) < n; ++j)
-      for (int i = 0; i < side && static_cast<int>(out.size()) < n; ++i) {
-        const double x = (i - side / 2) * 2.0 + 1.0, y = (j - side / 2) * 2.0 + 1.0;
-        if (pillar_clearance(x, y) >= 2.0) out.emplace_back(x, y, 0.0);
-      }
-    if (static_cast<int>(out.size()) < n) throw std::logic_error("bench grid too small");
-    return out;
-  }
-  static SceneConfig make_scene(int n) {
-    SceneConfig s;
-    const double half = side_for(n) + 8.0;  // grid half-width (m) + a row
-    for (int row = -20; row <= 20; ++row)
-      for (int col = -20; col <= 20; ++col) {
-        const double px = col * 8.0 + (row % 2 ? 4.0 : 0.0), py = row * 8.0;
-        if (std::abs(px) <= half && std::abs(py) <= half)
-          s.cylinders.push_back(Cylinder{{px, py}, 1.0, 12.0});
-      }
-    return s;
-  }
-
-  PhysicsWorld world_;
-  std::vector<FlightController> fc_;
-  VelocitySetpoint sp_;
-};
-
 void BM_PhysicsStep(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  HoverField field(n);
+  HoverField field(n, kDt);
   double total_s = 0;
   for (auto _ : state) {
     field.control();
@@ -129,7 +63,7 @@ BENCHMARK(BM_PhysicsStep)
 /// args: drones, max range (m), mode (0 culled, 1 Bullet rayTest per ray).
 void BM_RayFrame(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  HoverField field(n);
+  HoverField field(n, kDt);
   SensorConfig cfg;
   cfg.count = 8;
   cfg.max_range_m = static_cast<double>(state.range(1));
@@ -165,6 +99,30 @@ BENCHMARK(BM_RayFrame)
     ->Unit(benchmark::kMicrosecond);
 
 /// One flight-controller update (the server runs one per drone per step).
+/// args: drones, physics rate (Hz). Sensors as config/thesis_course.yaml: 8
+/// rays of 6 m, at the 50 Hz control rate.
+void BM_ServerTick(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const double hz = static_cast<double>(state.range(1));
+  HoverField field(n, 1.0 / hz);
+  SensorConfig sensors;
+  sensors.count = 8;
+  sensors.max_range_m = 6.0;
+  const int substeps = static_cast<int>(std::lround(hz / 50.0));
+  double hit_frac = 0, total_s = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    hit_frac = field.server_tick(substeps, sensors);
+    total_s += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  state.counters["us_per_tick"] = total_s * 1e6 / static_cast<double>(state.iterations());
+  state.counters["hit_frac"] = hit_frac;
+}
+BENCHMARK(BM_ServerTick)
+    ->ArgNames({"drones", "physics_hz"})
+    ->ArgsProduct({{6, 16, 32, 64, 128}, {1000, 500, 250}})
+    ->Unit(benchmark::kMicrosecond);
+
 void BM_Controller(benchmark::State& state) {
   FlightController fc(QuadrotorParams{}, ControllerConfig{});
   RigidState s;

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Issue 8 (scale): ddswarm's lockstep and real-time figures for N agent
-# processes, each beside the bare Fast DDS floor of the same run, and Table 1's
-# wall time split into start-up, flight and teardown.
+# processes, each beside the bare Fast DDS floor of the same run and beside
+# that floor with a lockstep server's physics between its ticks (the most
+# plain lockstep can tick on the machine), and Table 1's wall time split into
+# start-up, flight and teardown.
 #
 # Usage: bench/swarm_bench.sh [options]
 #   --bin DIR          built binaries (default: build/default/bin)
@@ -27,7 +29,9 @@
 #   --floor-time S     floor seconds measured per N (default 5)
 #   --floor-repeats K  floor runs per N and discovery, all sizes once per round (default 3);
 #                      ratios use the median: one 5 s sample moved 1.7x within minutes
-#   --skip floor,lockstep,realtime,hosts,table1   parts to leave out
+#   --skip floor,ceiling,lockstep,realtime,hosts,table1   parts to leave out (ceiling: the
+#                      floor with the physics between ticks, once per lockstep physics rate,
+#                      in --floor-repeats rounds; skipping floor skips it too)
 #   --hosts-drones N   agent-host part: N drones of config/swarm_field.yaml in real time,
 #                      flown by --agent-hosts K processes (default 512 and 2), physics and
 #                      sensor rates --hosts-physics / --hosts-sensors Hz (default 250 / 10)
@@ -183,6 +187,69 @@ floor_of() {
   floor_stats "$1" "$want" any | cut -d' ' -f1
 }
 
+# ---------------------------------------------------------------- ceiling
+# The floor with a lockstep server's physics between its ticks (dds_floor
+# --physics-hz: the bench scenario's N drones hovering in its scene, every
+# drone's controller and Bullet for one 50 Hz tick, then its sensors): what
+# plain lockstep could tick were ddswarm's own DDS path and agents as cheap
+# as the floor's. Rounds like the floor's, each
+# lockstep physics rate, the discovery the launcher's auto picks.
+CEIL_CSV="$OUT/ceiling.csv"
+ceiling_of() {  # ceiling_of N HZ: median ticks/s of the good runs, or nan
+  [ -f "$CEIL_CSV" ] || { echo nan; return; }
+  $PY - "$CEIL_CSV" "$1" "$2" <<'EOF'
+import csv, statistics, sys
+n, hz = int(sys.argv[2]), float(sys.argv[3])
+v = [float(r["ticks_per_s"]) for r in csv.DictReader(open(sys.argv[1]))
+     if int(r["n"]) == n and r["ok"] == "1" and float(r["physics_hz"]) == hz]
+print(statistics.median(v) if v else "nan")
+EOF
+}
+if ! skip floor && ! skip ceiling; then
+  rm -f "$CEIL_CSV"
+  small="" large=""
+  for n in $SIZES; do
+    if [ "$n" -gt 32 ]; then large+="${large:+,}$n"; else small+="${small:+,}$n"; fi
+  done
+  for round in $(seq "$FLOOR_REPEATS"); do
+    for hz in ${LS_PHYSICS:-$PHYS_HZ}; do
+      echo "swarm_bench: ceiling round $round of $FLOOR_REPEATS, $hz Hz physics" >&2
+      for part in "simple $small" "server $large"; do
+        set -- $part
+        [ $# -eq 2 ] || continue
+        "$BIN/dds_floor" --drones "$2" --discovery "$1" --physics-hz "$hz" --physics-scenario "$SCENARIO" --time "$FLOOR_TIME" \
+          --explicit-ids --csv "$CEIL_CSV" --log-dir "$OUT/floor-logs" "${FLOOR_STREAM_ARGS[@]}" >/dev/null
+      done
+    done
+  done
+  echo
+  echo "== the ceiling of lockstep: the floor with a lockstep server's physics between ticks (the scenario's N drones hovering, their controllers, Bullet and sensors), median of $FLOOR_REPEATS round(s); plain lockstep can tick no faster, and no lockstep on $(nproc) cores faster than with the physics hidden =="
+  echo "| N | physics (Hz) | floor ticks/s | floor with physics ticks/s | its ratio to the floor (plain lockstep's ceiling) | floor CPU per tick (µs) | physics CPU per tick (µs) | physics hidden: $(nproc) cores ÷ both (ticks/s) | its ratio to the floor |"
+  echo "|---|---|---|---|---|---|---|---|---|"
+  $PY - "$FLOOR_CSV" "$CEIL_CSV" "$(nproc)" "$SIZES" "${LS_PHYSICS:-$PHYS_HZ}" <<'EOF'
+import csv, statistics, sys
+floor = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
+ceil = [r for r in csv.DictReader(open(sys.argv[2])) if r["ok"] == "1"]
+cores = int(sys.argv[3])
+med = lambda v: statistics.median(v) if v else float("nan")
+cell = lambda v, f: "-" if v != v else f.format(v)
+for n in map(int, sys.argv[4].split()):
+    want = "server" if n > 32 else "simple"  # as ddswarm-launch's auto
+    f = [r for r in floor if int(r["n"]) == n and r["discovery"] == want] or \
+        [r for r in floor if int(r["n"]) == n]
+    f_tps = med([float(r["ticks_per_s"]) for r in f])
+    f_us = med([float(r["busy_cores"]) / float(r["ticks_per_s"]) * 1e6 for r in f])
+    for hz in map(float, sys.argv[5].split()):
+        c = [r for r in ceil if int(r["n"]) == n and float(r["physics_hz"]) == hz]
+        c_tps = med([float(r["ticks_per_s"]) for r in c])
+        p_us = med([float(r["physics_us"]) for r in c])
+        hidden = cores * 1e6 / (f_us + p_us)
+        print(f"| {n} | {hz:.0f} | {cell(f_tps, '{:.0f}')} | {cell(c_tps, '{:.0f}')} | "
+              f"{cell(c_tps / f_tps, '{:.2f}')} | {cell(f_us, '{:.0f}')} | {cell(p_us, '{:.0f}')} | "
+              f"{cell(hidden, '{:.0f}')} | {cell(hidden / f_tps, '{:.2f}')} |")
+EOF
+fi
+
 # ---------------------------------------------------------------- one swarm
 # run_swarm MODE N SECONDS: launches N agents, takes off, holds, probes; prints the probe line.
 RUN_SCENARIO=""   # run_swarm's scenario (default: $SCENARIO)
@@ -286,21 +353,22 @@ if ! skip lockstep; then
         [ -n "$LS_PHYSICS" ] && { RUN_EXTRA+=(--set "sim.physics_rate_hz=$hz"); RUN_TAG+="-${hz}hz"; }
         echo "swarm_bench: lockstep N=$n, $v, physics $hz Hz (load $(cut -d' ' -f1 /proc/loadavg)) ..." >&2
         RUN_TOOL_ARGS=("${STREAM_TOOL_ARGS[@]}")
-        echo "variant=$v physics=$hz $(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n")" >>"$OUT/lockstep.txt"
+        echo "variant=$v physics=$hz $(run_swarm lockstep "$n" "$LS_TIME") load=$(cut -d' ' -f1 /proc/loadavg) floor=$(floor_of "$n") ceiling=$(ceiling_of "$n" "$hz")" >>"$OUT/lockstep.txt"
       done
     done
   done
   RUN_EXTRA=(); RUN_TAG=""; RUN_TOOL_ARGS=()
   echo
   echo "== lockstep: $STREAMS state and commands; ticks/s with physics (Hz as given) and sensors (8 rays, $SENS_HZ Hz), N agent processes (hosts: the N drones in $LS_HOSTS_K agent-host processes); ${LS_TIME} s measured while holding =="
-  echo "| N | variant | physics (Hz) | ticks/s | real-time factor | floor ticks/s | ratio to floor | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| N | variant | physics (Hz) | ticks/s | real-time factor | floor ticks/s | ratio to floor | floor with physics (ticks/s) | ratio to it | CPU sim | CPU agents (each) | CPU discovery server | agent RSS (MB) | agent PSS (MB) | bring-up + discovery (s) | drone contacts | load | note |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   while read -r l; do
-    n=$(field n "$l"); t=$(field ticks_per_s "$l"); f=$(field floor "$l")
+    n=$(field n "$l"); t=$(field ticks_per_s "$l"); f=$(field floor "$l"); c=$(field ceiling "$l")
     ratio=$(echo "$t $f" | awk '{ if ($1+0 > 0 && $2+0 > 0) printf "%.2f", $1 / $2; else print "-" }')
+    cratio=$(echo "$t $c" | awk '{ if ($1+0 > 0 && $2+0 > 0) printf "%.2f", $1 / $2; else print "-" }')
     rtf=$(echo "$t" | awk '{ if ($1+0 > 0) printf "%.1f", $1 / 50; else print "-" }')
-    printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "$(field physics "$l")" "${t:--}" "$rtf" \
-      "$(echo "$f" | awk '{ printf "%.0f", $1 }')" "$ratio" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
+    printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s | %s | %s |\n" "$n" "$(field variant "$l")" "$(field physics "$l")" "${t:--}" "$rtf" \
+      "$(echo "$f" | awk '{ printf "%.0f", $1 }')" "$ratio" "$(echo "${c:-nan}" | awk '{ print ($1 == "nan") ? "-" : sprintf("%.0f", $1) }')" "$cratio" "$(field cpu_sim "$l")" "$(field cpu_agents "$l")" \
       "$(field cpu_agent_each "$l")" "$(field cpu_ds "$l")" "$(field rss_agent_mb "$l")" "$(field pss_agent_mb "$l")" \
       "$(up_cell "$l")" "$(field contacts "$l")" "$(field load "$l")" \
       "$(note_cell "$l")"

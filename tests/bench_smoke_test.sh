@@ -14,6 +14,12 @@ for title in "bare Fast DDS lockstep floor" "== lockstep:" "== real time:" "== T
 done
 # Each table has a row for N = 3 with a figure in it, and Table 1 its split.
 grep -Eq '^\| 3 \| simple \| [0-9]+ \|' "$out" || fail "floor row for N=3 missing or empty"
+# The ceiling of lockstep (the floor with the server's physics between ticks,
+# and with the physics hidden), at each physics rate flown, every cell a figure.
+grep -q "== the ceiling of lockstep" "$out" || fail "no ceiling table"
+for hz in 1000 250; do
+  grep -Eq "^\\| 3 \\| $hz( \\| [0-9.]+){7} \\|$" "$out" || fail "ceiling row at $hz Hz for N=3 missing or empty"
+done
 for v in plain pipelined hosts; do
   for hz in 1000 250; do
     grep -Eq "^\\| 3 \\| $v \\| $hz \\| [0-9.]+ \\| [0-9.]+ \\|" "$out" ||
