@@ -192,8 +192,8 @@ floor_of() {
 # --physics-hz: the bench scenario's N drones hovering in its scene, every
 # drone's controller and Bullet for one 50 Hz tick, then its sensors): what
 # plain lockstep could tick were ddswarm's own DDS path and agents as cheap
-# as the floor's. Rounds like the floor's, each
-# lockstep physics rate, the discovery the launcher's auto picks.
+# as the floor's. In rounds like the floor's, at each lockstep physics rate,
+# with the discovery the launcher's auto picks.
 CEIL_CSV="$OUT/ceiling.csv"
 ceiling_of() {  # ceiling_of N HZ: median ticks/s of the good runs, or nan
   [ -f "$CEIL_CSV" ] || { echo nan; return; }
