@@ -98,7 +98,6 @@ BENCHMARK(BM_RayFrame)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
-/// One flight-controller update (the server runs one per drone per step).
 /// args: drones, physics rate (Hz). Sensors as config/thesis_course.yaml: 8
 /// rays of 6 m, at the 50 Hz control rate.
 void BM_ServerTick(benchmark::State& state) {
@@ -123,6 +122,7 @@ BENCHMARK(BM_ServerTick)
     ->ArgsProduct({{6, 16, 32, 64, 128}, {1000, 500, 250}})
     ->Unit(benchmark::kMicrosecond);
 
+/// One flight-controller update (the server runs one per drone per step).
 void BM_Controller(benchmark::State& state) {
   FlightController fc(QuadrotorParams{}, ControllerConfig{});
   RigidState s;
