@@ -145,18 +145,14 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
   // --physics-hz: what a lockstep server computes between ticks, for N
   // hovering drones (bench/hover_field.hpp), in place of --work-us's wait.
   std::optional<bench::HoverField> field;
-  sim::SensorConfig sensors;
-  sensors.count = kRays;
-  sensors.max_range_m = 6.0;
-  int sensor_every = 1;
-  int substeps = static_cast<int>(std::lround(g_physics_hz / 50.0));  // 50 Hz control
+  bench::TickPlan plan = bench::TickPlan::at(g_physics_hz);
   if (g_physics_hz > 0 && g_physics_scenario.empty()) {
     field.emplace(n, 1.0 / g_physics_hz);
   } else if (g_physics_hz > 0) {
-    sim::ServerConfig c = sim::load_server_config(g_physics_scenario);
-    sensors = c.sensors;
-    sensor_every = c.sim.sensor_every();
-    substeps = static_cast<int>(std::lround(g_physics_hz / c.sim.control_rate_hz));
+    const sim::ServerConfig c = sim::load_server_config(g_physics_scenario);
+    plan = bench::TickPlan::at(g_physics_hz, c.sim.control_rate_hz);
+    plan.sensors = c.sensors;
+    plan.sensor_every = c.sim.sensor_every();
     field.emplace(c.scene, c.quadrotor, c.controller, c.scene.start_positions(n, c.scenario.seed),
                   1.0 / g_physics_hz);
   }
@@ -264,7 +260,7 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
         }
         if (field) {
           const double c0 = thread_cpu_s();
-          field->server_tick(substeps, sensors, tick % sensor_every == 0);
+          field->server_tick(plan, tick);
           if (measuring) physics_cpu_s += thread_cpu_s() - c0;
         }
         if (g_work_us > 0) {  // busy, as a physics step is: no sleep, no yield
@@ -325,8 +321,8 @@ int main(int argc, char** argv) {
     app.add_option(
            "--physics-hz", g_physics_hz,
            "step a lockstep server's physics between ticks: N hovering drones' flight "
-           "controllers and Bullet at this rate (Hz) for one 50 Hz tick, then 8 rays of 6 m per "
-           "drone (0: none, the floor). The floor with it is the most plain lockstep can tick "
+           "controllers and Bullet at this rate (Hz) for one control tick, then their sensors "
+           "(0: none, the floor). The floor with it is the most plain lockstep can tick "
            "(its physics CPU per tick is printed)")
         ->check(CLI::Range(0.0, 4000.0));
     app.add_option(

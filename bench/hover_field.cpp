@@ -72,9 +72,18 @@ void HoverField::control_and_step() {
   world_.step(dt_);
 }
 
-double HoverField::server_tick(int substeps, const sim::SensorConfig& sensors, bool rays) {
-  for (int k = 0; k < substeps; ++k) control_and_step();
-  if (!rays) return 0.0;
+TickPlan TickPlan::at(double physics_hz, double control_hz) {
+  TickPlan p;
+  p.substeps = static_cast<int>(std::lround(physics_hz / control_hz));
+  p.sensors.count = 8;
+  p.sensors.max_range_m = 6.0;
+  return p;
+}
+
+double HoverField::server_tick(const TickPlan& plan, std::uint64_t tick) {
+  for (int k = 0; k < plan.substeps; ++k) control_and_step();
+  if (tick % static_cast<std::uint64_t>(plan.sensor_every) != 0) return 0.0;
+  const sim::SensorConfig& sensors = plan.sensors;
   long hits = 0, cast = 0;
   for (int d = 0; d < world_.size(); ++d) {
     world_.cast_rays(d, sensors, rng_, range_, hit_);

@@ -15,6 +15,18 @@
 
 namespace ddswarm::bench {
 
+/// What a lockstep server computes per control tick: substeps of every
+/// drone's controller and physics, then, every sensor_every-th tick, one
+/// sensor frame.
+struct TickPlan {
+  int substeps = 20;
+  sim::SensorConfig sensors;
+  int sensor_every = 1;
+  /// physics_hz / control_hz substeps; config/thesis_course.yaml's sensors
+  /// (8 rays of 6 m) at the control rate.
+  static TickPlan at(double physics_hz, double control_hz = 50.0);
+};
+
 class HoverField {
  public:
   /// N drones over the pillar field, stock airframe and controller.
@@ -26,10 +38,9 @@ class HoverField {
   /// Every drone's controller once, the rotor commands set (no step).
   void control();
   void control_and_step();
-  /// What a lockstep server computes for one control tick: substeps of
-  /// controller and physics, then, when rays, one sensor frame (sensors.count
-  /// rays per drone). Returns the share of rays that hit something.
-  double server_tick(int substeps, const sim::SensorConfig& sensors, bool rays = true);
+  /// Control tick number tick of plan. Returns the share of its rays that hit
+  /// something (0 on a tick without a sensor frame).
+  double server_tick(const TickPlan& plan, std::uint64_t tick = 0);
 
   sim::PhysicsWorld& world() { return world_; }
 

@@ -104,14 +104,11 @@ void BM_ServerTick(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const double hz = static_cast<double>(state.range(1));
   HoverField field(n, 1.0 / hz);
-  SensorConfig sensors;
-  sensors.count = 8;
-  sensors.max_range_m = 6.0;
-  const int substeps = static_cast<int>(std::lround(hz / 50.0));
+  const ddswarm::bench::TickPlan plan = ddswarm::bench::TickPlan::at(hz);
   double hit_frac = 0, total_s = 0;
   for (auto _ : state) {
     const auto t0 = Clock::now();
-    hit_frac = field.server_tick(substeps, sensors);
+    hit_frac = field.server_tick(plan);
     total_s += std::chrono::duration<double>(Clock::now() - t0).count();
   }
   state.counters["us_per_tick"] = total_s * 1e6 / static_cast<double>(state.iterations());
