@@ -10,6 +10,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <set>
 #include <vector>
@@ -71,7 +72,20 @@ void remove(const std::string& dir, const std::string& name, ShmCleanReport& r) 
   if (unlink(path.c_str()) == 0) {
     ++r.files_removed;
     r.bytes_freed += static_cast<std::uint64_t>(st.st_blocks) * 512u;
+    r.removed.push_back(name);
   }
+}
+
+/// True when path was modified less than min_age_s ago (or cannot be read:
+/// leave it).
+bool young(const std::string& path, double min_age_s) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) return true;
+  timespec now{};
+  clock_gettime(CLOCK_REALTIME, &now);
+  const double age = static_cast<double>(now.tv_sec - st.st_mtim.tv_sec) +
+                     static_cast<double>(now.tv_nsec - st.st_mtim.tv_nsec) * 1e-9;
+  return age < min_age_s;
 }
 
 /// A transport segment, port or data-sharing pool, and a port's mutex with it.
@@ -82,7 +96,7 @@ void remove_segment(const std::string& dir, const std::string& name, ShmCleanRep
 
 }  // namespace
 
-ShmCleanReport clean_zombie_shm(const std::string& dir) {
+ShmCleanReport clean_zombie_shm(const std::string& dir, double min_age_s) {
   ShmCleanReport r;
   const auto names = list_dir(dir);
   const std::set<std::string> present(names.begin(), names.end());
@@ -102,6 +116,11 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
       // that send to it, and a restarted owner must reopen that same file
       // (unlinked, the senders would push into a file nobody reads).
       const std::string base = n.substr(0, n.size() - 3);
+      if (young(dir + "/" + n, min_age_s) ||
+          (present.count(base) && young(dir + "/" + base, min_age_s))) {
+        ++r.too_young;
+        continue;
+      }
       if (locked(dir + "/" + n) || is_mapped(base)) {
         ++r.in_use;
         continue;
@@ -116,6 +135,10 @@ ShmCleanReport clean_zombie_shm(const std::string& dir) {
       // leaves the port itself while a sender still counted on it (one file
       // per SIGKILLed sender piled up by the thousand in /dev/shm on a
       // machine that ran the tests). A data-sharing pool never has a lock.
+      if (young(dir + "/" + n, min_age_s)) {
+        ++r.too_young;
+        continue;
+      }
       if (is_mapped(n)) {
         ++r.in_use;
         continue;

@@ -12,8 +12,12 @@
 //   fast_datasharing_<guid>_<entity> (data-sharing pools): no process maps it
 //     (/proc/*/maps).
 // Files in use by any live process, of any domain or user, are never touched.
+// Nor is a file younger than min_age_s: a participant starting meanwhile has
+// made its segment, port or lock file but not yet mapped or locked it, and
+// would lose it (tests run servers and participants side by side).
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace ddswarm {
 
@@ -21,10 +25,18 @@ struct ShmCleanReport {
   int files_removed = 0;
   std::uint64_t bytes_freed = 0;
   int in_use = 0;  ///< segments and ports left alone because a live process holds them
+  int too_young = 0;  ///< left alone because younger than min_age_s (maybe being made)
+  std::vector<std::string> removed;  ///< the files' names
 };
 
+/// How old a file must be (by its mtime) before it may be a zombie. Fast DDS
+/// makes a file and maps or locks it within microseconds; seconds leave a
+/// loaded machine room.
+inline constexpr double kShmZombieMinAgeS = 2.0;
+
 /// Cleans dir (default /dev/shm). Never throws; unreadable entries are skipped.
-ShmCleanReport clean_zombie_shm(const std::string& dir = "/dev/shm");
+ShmCleanReport clean_zombie_shm(const std::string& dir = "/dev/shm",
+                                double min_age_s = kShmZombieMinAgeS);
 
 /// The lowest participant id in [first_id, max_id] whose two RTPS unicast ports in
 /// domain_id (metatraffic and user data) have no shared-memory port file in

@@ -9,9 +9,11 @@
 #include <gtest/gtest.h>
 #include <sys/file.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <string>
 
@@ -45,7 +47,7 @@ TEST(ShmClean, RemovesTransportSegmentsAndPortsWhoseOwnerIsGone) {
   d.touch("fastrtps_port7411_el", 0);
   d.touch("sem.fastrtps_port7411_mutex", 32);
   d.touch("unrelated_file");
-  auto r = clean_zombie_shm(d.path);
+  auto r = clean_zombie_shm(d.path, 0.0);
   EXPECT_EQ(r.files_removed, 5);
   EXPECT_GT(r.bytes_freed, 0u);
   EXPECT_FALSE(d.has("fastrtps_0123456789abcdef"));
@@ -66,7 +68,7 @@ TEST(ShmClean, KeepsWhatALiveProcessHolds) {
   ASSERT_TRUE(seg.ok());
   d.touch("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.01_0.0.1.4");  // nobody maps it
 
-  auto r = clean_zombie_shm(d.path);
+  auto r = clean_zombie_shm(d.path, 0.0);
   EXPECT_TRUE(d.has("fastrtps_00000000000000aa"));
   EXPECT_TRUE(d.has("fastrtps_00000000000000aa_el"));
   EXPECT_TRUE(d.has("fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.00_0.0.1.4"));
@@ -83,7 +85,7 @@ TEST(ShmClean, KeepsADeadOwnersPortThatLiveSendersStillMap) {
   Mapping port(d.touch("fastrtps_port7413"));
   ASSERT_TRUE(port.ok());
   d.touch("fastrtps_port7413_el", 0);
-  auto r = clean_zombie_shm(d.path);
+  auto r = clean_zombie_shm(d.path, 0.0);
   EXPECT_TRUE(d.has("fastrtps_port7413"));
   EXPECT_TRUE(d.has("fastrtps_port7413_el"));
   EXPECT_EQ(r.files_removed, 0);
@@ -98,12 +100,34 @@ TEST(ShmClean, RemovesAPortWithoutAnOwnerOrASender) {
   d.touch("sem.fastrtps_port7415_mutex", 32);
   Mapping sent_to(d.touch("fastrtps_port7417"));  // a live sender still maps this one
   ASSERT_TRUE(sent_to.ok());
-  auto r = clean_zombie_shm(d.path);
+  auto r = clean_zombie_shm(d.path, 0.0);
   EXPECT_FALSE(d.has("fastrtps_port7415"));
   EXPECT_FALSE(d.has("sem.fastrtps_port7415_mutex"));
   EXPECT_TRUE(d.has("fastrtps_port7417"));
   EXPECT_EQ(r.files_removed, 2);
   EXPECT_EQ(r.in_use, 1);
+}
+
+// A participant starting beside the clean-up has made its files but not yet
+// locked or mapped them: they look like a dead process's, and removing them
+// would cut it off its swarm. Only files older than the minimum age may go.
+TEST(ShmClean, LeavesFilesBeingMadeToTheirMaker) {
+  TempDir d;
+  const std::string names[] = {"fastrtps_port7419", "fastrtps_port7419_el",
+                               "fast_datasharing_01.0f.00.00.00.00.00.00.00.00.00.02_0.0.1.4"};
+  for (const auto& n : names) d.touch(n);
+  auto r = clean_zombie_shm(d.path);
+  for (const auto& n : names) EXPECT_TRUE(d.has(n)) << n;
+  EXPECT_EQ(r.files_removed, 0);
+  EXPECT_EQ(r.too_young, 2);  // the port with its lock, and the pool
+
+  // The same files once they are older than the minimum age: zombies.
+  const timespec past[2] = {{time(nullptr) - 10, 0}, {time(nullptr) - 10, 0}};
+  for (const auto& n : names) ASSERT_EQ(utimensat(AT_FDCWD, (d.path + "/" + n).c_str(), past, 0), 0);
+  r = clean_zombie_shm(d.path);
+  for (const auto& n : names) EXPECT_FALSE(d.has(n)) << n;
+  EXPECT_EQ(r.files_removed, 3);
+  EXPECT_EQ(r.removed.size(), 3u);
 }
 
 // A server restarted after a SIGKILL must not come up on its dead

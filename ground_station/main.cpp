@@ -341,8 +341,17 @@ int main(int argc, char** argv) {
       // waits for its own connections to the agents (wait_for_server).
       bool ok = gs.wait_for_online(wait_count, wait_timeout);
       auto st = gs.status();
-      std::printf("%d/%d agents online\n", st.drones_online, st.drones_total);
-      return ok ? 0 : 1;
+      if (ok) {
+        std::printf("%d/%d agents online\n", st.drones_online, st.drones_total);
+        return 0;
+      }
+      // This station may hear agents the server does not: say whose view timed out.
+      const int asked = wait_count < 0 ? st.drones_total : wait_count;
+      std::printf("timed out after %g s: the server hears %d of the %d agents asked for "
+                  "(this ground station hears %d/%d online)\n",
+                  wait_timeout, std::max(st.drones_server_hears, 0), asked, st.drones_online,
+                  st.drones_total);
+      return 1;
     }
     if (*status) {
       gs.wait_task_status(file.gs.discovery_timeout_s);  // latched: follows the match when there is one

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <optional>
+#include <string>
 
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
@@ -52,9 +53,16 @@ int main(int argc, char** argv) {
     ddswarm::install_stop_signals();
     // Segments that crashed runs left in /dev/shm pile up until the next run
     // cannot map its own: clear the zombies (never a live process's) first.
-    if (auto r = ddswarm::clean_zombie_shm(); r.files_removed > 0)
-      spdlog::info("removed {} shared-memory files ({:.1f} MB) left by crashed processes",
-                   r.files_removed, r.bytes_freed / 1e6);
+    // Named, so a log tells which process's files went.
+    if (auto r = ddswarm::clean_zombie_shm(); r.files_removed > 0) {
+      constexpr std::size_t kNamed = 6;
+      std::string names;
+      for (std::size_t i = 0; i < r.removed.size() && i < kNamed; ++i)
+        names += (i ? ", " : "") + r.removed[i];
+      if (r.removed.size() > kNamed) names += fmt::format(" and {} more", r.removed.size() - kNamed);
+      spdlog::info("removed {} shared-memory files ({:.1f} MB) left by crashed processes: {}",
+                   r.files_removed, r.bytes_freed / 1e6, names);
+    }
     ddswarm::install_rejoin_signal();
     // A new server each time SIGUSR1 asks before a mission (SimServer::run).
     std::uint64_t rival = 0;
