@@ -116,13 +116,13 @@ ShmCleanReport clean_zombie_shm(const std::string& dir, double min_age_s) {
       // that send to it, and a restarted owner must reopen that same file
       // (unlinked, the senders would push into a file nobody reads).
       const std::string base = n.substr(0, n.size() - 3);
-      if (young(dir + "/" + n, min_age_s) ||
-          (present.count(base) && young(dir + "/" + base, min_age_s))) {
-        ++r.too_young;
-        continue;
-      }
       if (locked(dir + "/" + n) || is_mapped(base)) {
         ++r.in_use;
+        continue;
+      }
+      if (young(dir + "/" + n, min_age_s) ||
+          (present.count(base) && young(dir + "/" + base, min_age_s))) {
+        ++r.spared;
         continue;
       }
       remove(dir, n, r);
@@ -135,12 +135,12 @@ ShmCleanReport clean_zombie_shm(const std::string& dir, double min_age_s) {
       // leaves the port itself while a sender still counted on it (one file
       // per SIGKILLed sender piled up by the thousand in /dev/shm on a
       // machine that ran the tests). A data-sharing pool never has a lock.
-      if (young(dir + "/" + n, min_age_s)) {
-        ++r.too_young;
-        continue;
-      }
       if (is_mapped(n)) {
         ++r.in_use;
+        continue;
+      }
+      if (young(dir + "/" + n, min_age_s)) {
+        ++r.spared;
         continue;
       }
       remove_segment(dir, n, r);

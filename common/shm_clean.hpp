@@ -25,7 +25,7 @@ struct ShmCleanReport {
   int files_removed = 0;
   std::uint64_t bytes_freed = 0;
   int in_use = 0;  ///< segments and ports left alone because a live process holds them
-  int too_young = 0;  ///< left alone because younger than min_age_s (maybe being made)
+  int spared = 0;  ///< unused by every sign but younger than min_age_s: left (maybe being made)
   std::vector<std::string> removed;  ///< the files' names
 };
 

@@ -119,7 +119,7 @@ TEST(ShmClean, LeavesFilesBeingMadeToTheirMaker) {
   auto r = clean_zombie_shm(d.path);
   for (const auto& n : names) EXPECT_TRUE(d.has(n)) << n;
   EXPECT_EQ(r.files_removed, 0);
-  EXPECT_EQ(r.too_young, 2);  // the port with its lock, and the pool
+  EXPECT_EQ(r.spared, 2);  // the port with its lock, and the pool
 
   // The same files once they are older than the minimum age: zombies.
   const timespec past[2] = {{time(nullptr) - 10, 0}, {time(nullptr) - 10, 0}};

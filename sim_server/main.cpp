@@ -54,7 +54,12 @@ int main(int argc, char** argv) {
     // Segments that crashed runs left in /dev/shm pile up until the next run
     // cannot map its own: clear the zombies (never a live process's) first.
     // Named, so a log tells which process's files went.
-    if (auto r = ddswarm::clean_zombie_shm(); r.files_removed > 0) {
+    const auto r = ddswarm::clean_zombie_shm();
+    if (r.spared > 0)
+      spdlog::info("left {} unused shared-memory files younger than {} s (a starting "
+                   "participant's, or removed by a later start)",
+                   r.spared, ddswarm::kShmZombieMinAgeS);
+    if (r.files_removed > 0) {
       constexpr std::size_t kNamed = 6;
       std::string names;
       for (std::size_t i = 0; i < r.removed.size() && i < kNamed; ++i)
