@@ -136,10 +136,16 @@ struct Recorder::Impl {
   }
 
   /// A new participant with every reader. The old one, if any, is closed
-  /// first: no callback of it runs afterwards.
-  void join() {
+  /// first: no callback of it runs afterwards. After a stop longer than the
+  /// lease (again: true) it joins without the shared-memory transport, as an
+  /// agent does once cut off: the server, whose sends into the stopped
+  /// recorder's port had failed, took about 4 s to reach a new shared-memory
+  /// participant, and UDP on 127.0.0.1 reached it at once (docs/faults.md).
+  void join(bool again = false) {
     dds.reset();  // the old participant leaves before the new one joins
-    dds = std::make_unique<Participant>(dds_cfg, "ddswarm-record");
+    DdsConfig cfg = dds_cfg;
+    if (again) cfg.shm_transport = false;
+    dds = std::make_unique<Participant>(cfg, "ddswarm-record");
     for (const auto& subscribe : subscriptions) subscribe(*dds);
   }
 
@@ -181,7 +187,10 @@ struct Recorder::Impl {
           spdlog::warn(
               "ddswarm-record: {}; what no writer kept meanwhile is counted as never received",
               why);
-          join();
+          if (rejoins == 0 && dds_cfg.shared_memory && dds_cfg.shm_transport)
+            spdlog::warn("ddswarm-record: joining again without the shared-memory transport "
+                         "(UDP on 127.0.0.1), which reaches a re-joined participant at once");
+          join(true);
           ++rejoins;
           lease.restart(wall_seconds());
         }

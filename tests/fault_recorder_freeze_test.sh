@@ -19,7 +19,9 @@ kill -STOP "$PID_rec" "$PID_trace"
 sleep 6  # twice the 3 s lease
 kill -CONT "$PID_rec" "$PID_trace"
 resumed_ns=$(date +%s%N)
-sleep 5
+# Room for the trace's re-join, which took 0.2-1.1 s here (its check below
+# wants 2 s of rows starting 2 s after the gap).
+sleep 7
 kill -TERM "$PID_rec" "$PID_trace"
 wait_pid "$PID_rec" 20 || fail "the recorder did not finish on SIGTERM"
 wait_pid "$PID_trace" 20 || fail "the trace did not finish on SIGTERM"
@@ -39,14 +41,19 @@ grep -q "joining again as a new participant" "$WORK/rec.log" ||
   fail "the recorder outlived its 3 s lease but did not join again"
 grep -Eq "ddswarm/swarm_state +[0-9]+ \([0-9]+ more were sent but never received\)" "$WORK/rec.log" ||
   fail "the swarm states sent while the recorder was stopped are not counted as missed"
+grep -q "joining again without the shared-memory transport" "$WORK/rec.log" ||
+  fail "the recorder re-joined on shared memory"
 grep -Eq "joined DDS again 1 time\(s\).*; [0-9]+ samples received twice were kept once" "$WORK/rec.log" ||
   fail "the recorder does not report its re-join"
 
 "$BIN/ddswarm-record" info --messages "$WORK/run.mcap" >"$WORK/run.info" || fail "the recording is unreadable"
 head -20 "$WORK/run.info"
-after=$(awk -v t="$resumed_ns" '$2 == "ddswarm/swarm_state" && $1 > t + 2000000000' "$WORK/run.info" | wc -l)
+after=$(awk -v t="$resumed_ns" '$2 == "ddswarm/swarm_state" && $1 > t + 2000000000 && $1 <= t + 5000000000' \
+  "$WORK/run.info" | wc -l)
 echo "swarm states recorded from 2 s after SIGCONT: $after"
-[ "$after" -ge 50 ] || fail "the recorder did not hear the swarm again after SIGCONT ($after states in 3 s)"
+# 50 Hz: ~150 in those 3 s. Re-joined on shared memory, the recorder heard
+# none for about 4 s after SIGCONT in 5 runs of 6 (31-65 here); by UDP at once.
+[ "$after" -ge 100 ] || fail "the recorder did not hear the swarm again after SIGCONT ($after states in 3 s)"
 scenes=$(awk '$2 == "ddswarm/scene"' "$WORK/run.info" | wc -l)
 [ "$scenes" -eq 1 ] || fail "the scene is in the recording $scenes times (its history came again after the re-join)"
 dups=$(awk '$2 == "ddswarm/swarm_state" { print $4 }' "$WORK/run.info" | sort | uniq -d | wc -l)
