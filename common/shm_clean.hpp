@@ -14,7 +14,7 @@
 // Files in use by any live process, of any domain or user, are never touched.
 // Nor is a file younger than min_age_s: a participant starting meanwhile has
 // made its segment, port or lock file but not yet mapped or locked it, and
-// would lose it (tests run servers and participants side by side).
+// would lose it (a launcher starts the server and its agents together).
 #include <cstdint>
 #include <string>
 #include <vector>

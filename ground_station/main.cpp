@@ -347,10 +347,14 @@ int main(int argc, char** argv) {
       }
       // This station may hear agents the server does not: say whose view timed out.
       const int asked = wait_count < 0 ? st.drones_total : wait_count;
-      std::printf("timed out after %g s: the server hears %d of the %d agents asked for "
-                  "(this ground station hears %d/%d online)\n",
-                  wait_timeout, std::max(st.drones_server_hears, 0), asked, st.drones_online,
-                  st.drones_total);
+      if (st.drones_server_hears < 0)
+        std::printf("timed out after %g s: no server heard (this ground station hears %d/%d agents "
+                    "online)\n",
+                    wait_timeout, st.drones_online, st.drones_total);
+      else
+        std::printf("timed out after %g s: the server hears %d of the %d agents asked for (this "
+                    "ground station hears %d/%d online)\n",
+                    wait_timeout, st.drones_server_hears, asked, st.drones_online, st.drones_total);
       return 1;
     }
     if (*status) {

@@ -51,8 +51,9 @@ head -20 "$WORK/run.info"
 after=$(awk -v t="$resumed_ns" '$2 == "ddswarm/swarm_state" && $1 > t + 2000000000 && $1 <= t + 5000000000' \
   "$WORK/run.info" | wc -l)
 echo "swarm states recorded from 2 s after SIGCONT: $after"
-# 50 Hz: ~150 in those 3 s. Re-joined on shared memory, the recorder heard
-# none for about 4 s after SIGCONT in 5 runs of 6 (31-65 here); by UDP at once.
+# 50 Hz: ~150 in those 3 s. Re-joined on shared memory on a loaded machine,
+# the recorder heard none for about 4 s after SIGCONT in 5 runs of 6 (31 and
+# 34 here in two failed suite runs); by UDP at once.
 [ "$after" -ge 100 ] || fail "the recorder did not hear the swarm again after SIGCONT ($after states in 3 s)"
 scenes=$(awk '$2 == "ddswarm/scene"' "$WORK/run.info" | wc -l)
 [ "$scenes" -eq 1 ] || fail "the scene is in the recording $scenes times (its history came again after the re-join)"
