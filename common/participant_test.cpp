@@ -86,8 +86,9 @@ TEST(Participant, ReliableWriterServesBestEffortAndReliableReaders) {
   auto w = server.writer<msg::SwarmState>();
   auto& latest = agent.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_latest; },
                                                std::nullopt, Delivery::kLatest);
-  auto& all = recorder.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_all; },
-                                               std::nullopt, Delivery::kArchive);
+  auto& all = recorder.reader<msg::SwarmState>(
+      [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_all; }, std::nullopt,
+      Delivery::kArchive);
   EXPECT_EQ(latest.raw()->get_qos().reliability().kind, fdds::BEST_EFFORT_RELIABILITY_QOS);
   EXPECT_EQ(all.raw()->get_qos().reliability().kind, fdds::RELIABLE_RELIABILITY_QOS);
   EXPECT_EQ(w.raw()->get_qos().reliability().kind, fdds::RELIABLE_RELIABILITY_QOS);

@@ -123,7 +123,8 @@ TEST(ShmClean, LeavesFilesBeingMadeToTheirMaker) {
 
   // The same files once they are older than the minimum age: zombies.
   const timespec past[2] = {{time(nullptr) - 10, 0}, {time(nullptr) - 10, 0}};
-  for (const auto& n : names) ASSERT_EQ(utimensat(AT_FDCWD, (d.path + "/" + n).c_str(), past, 0), 0);
+  for (const auto& n : names)
+    ASSERT_EQ(utimensat(AT_FDCWD, (d.path + "/" + n).c_str(), past, 0), 0);
   r = clean_zombie_shm(d.path);
   for (const auto& n : names) EXPECT_FALSE(d.has(n)) << n;
   EXPECT_EQ(r.files_removed, 3);

@@ -1,10 +1,11 @@
 // ddswarm-launch: starts the server and one agent process per drone (and
 // optionally ground-station commands), prefixes their logs, supervises them.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "agent/agent_config.hpp"
 #include "common/cli_checks.hpp"
 #include "common/participant.hpp"
 #include "common/process.hpp"
@@ -70,6 +72,23 @@ int run_foreground(const std::vector<std::string>& argv, Launcher& procs,
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
+/// How long --gs waits for the agents before its first step: the bring-up,
+/// plus the longest first join of an agent that heard no scene (up to 1.5
+/// agent.rejoin_after_s, agent/agent_app.cpp) and came back as a new
+/// participant. With the default 30 s a launch gave up on an agent cut off at
+/// start-up that would have come back at 40-60 s (mp_comm_task, 2026-11-29).
+double agents_wait_s(const std::string& scenario) {
+  double rejoin = ddswarm::agent::AgentConfig{}.rejoin_after_s;
+  try {
+    const YAML::Node root = YamlDocument::load_file(scenario).root();
+    if (root["agent"] && root["agent"]["rejoin_after_s"])
+      rejoin = root["agent"]["rejoin_after_s"].as<double>();
+  } catch (const std::exception&) {
+    // The agents name a bad value themselves.
+  }
+  return 30.0 + 1.5 * std::max(rejoin, 0.0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -97,9 +116,11 @@ int main(int argc, char** argv) {
                    "flying) | restart (start a crashed agent again, up to 3 times each; it "
                    "rejoins the mission in force; anything else that dies stops everything)")
         ->check(CLI::IsMember({"stop", "keep", "restart"}));
-    app.add_option("--gs", gs_script,
-                   "ground-station commands to run once every agent is online, e.g. \"takeoff --wait; task\"; "
-                   "everything stops when they finish");
+    app.add_option(
+        "--gs", gs_script,
+        "ground-station commands to run once every agent is online (waited for up to 30 s plus "
+        "1.5 agent.rejoin_after_s, 90 s by default), e.g. \"takeoff --wait; task\"; "
+        "everything stops when they finish");
     app.add_flag("--gs-interactive", gs_interactive, "open the ground-station console here");
     app.add_option("--log-dir", log_dir, "write each process's log to DIR/<name>.log instead of the terminal");
     app.add_option("--duration", duration_s, "stop everything after this many wall seconds")
@@ -300,7 +321,8 @@ int main(int argc, char** argv) {
       return a;
     };
     if (!gs_script.empty()) {
-      std::vector<std::string> steps = {"wait-agents --count " + std::to_string(ids.empty() ? 0 : static_cast<int>(ids.size()))};
+      std::vector<std::string> steps = {fmt::format("wait-agents --count {} --timeout {:g}",
+                                                    ids.size(), agents_wait_s(scenario))};
       for (const auto& s : split_script(gs_script)) steps.push_back(s);
       for (const auto& step : steps) {
         if (stop_requested() || death_policy.stop()) break;

@@ -339,7 +339,21 @@ int main(int argc, char** argv) {
     if (*wait_agents) {
       // The server's view decides: the next command is another process, which
       // waits for its own connections to the agents (wait_for_server).
-      bool ok = gs.wait_for_online(wait_count, wait_timeout);
+      // In slices, saying how far it got: a large or a slow swarm takes a while.
+      constexpr double kProgressS = 10.0;
+      const double t0 = wall_seconds();
+      bool ok = false;
+      for (;;) {
+        const double left = wait_timeout - (wall_seconds() - t0);
+        ok = gs.wait_for_online(wait_count, std::clamp(left, 0.0, kProgressS));
+        if (ok || left <= kProgressS || stop_requested()) break;
+        const SwarmStatus now = gs.status();
+        std::fprintf(
+            stderr,
+            "ddswarm-gs: waiting for agents: the server hears %d of %d after %.0f s (of %g s)\n",
+            std::max(now.drones_server_hears, 0), wait_count < 0 ? now.drones_total : wait_count,
+            wall_seconds() - t0, wait_timeout);
+      }
       auto st = gs.status();
       if (ok) {
         std::printf("%d/%d agents online\n", st.drones_online, st.drones_total);
@@ -348,13 +362,15 @@ int main(int argc, char** argv) {
       // This station may hear agents the server does not: say whose view timed out.
       const int asked = wait_count < 0 ? st.drones_total : wait_count;
       if (st.drones_server_hears < 0)
-        std::printf("timed out after %g s: no server heard (this ground station hears %d/%d agents "
-                    "online)\n",
-                    wait_timeout, st.drones_online, st.drones_total);
+        std::printf(
+            "timed out after %g s: no server heard (this ground station hears %d/%d agents "
+            "online)\n",
+            wait_timeout, st.drones_online, st.drones_total);
       else
-        std::printf("timed out after %g s: the server hears %d of the %d agents asked for (this "
-                    "ground station hears %d/%d online)\n",
-                    wait_timeout, st.drones_server_hears, asked, st.drones_online, st.drones_total);
+        std::printf(
+            "timed out after %g s: the server hears %d of the %d agents asked for (this "
+            "ground station hears %d/%d online)\n",
+            wait_timeout, st.drones_server_hears, asked, st.drones_online, st.drones_total);
       return 1;
     }
     if (*status) {

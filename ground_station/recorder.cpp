@@ -189,8 +189,9 @@ struct Recorder::Impl {
               "ddswarm-record: {}; what no writer kept meanwhile is counted as never received",
               why);
           if (rejoins == 0 && dds_cfg.shared_memory && dds_cfg.shm_transport)
-            spdlog::warn("ddswarm-record: joining again without the shared-memory transport "
-                         "(UDP on 127.0.0.1), which reaches a re-joined participant at once");
+            spdlog::warn(
+                "ddswarm-record: joining again without the shared-memory transport "
+                "(UDP on 127.0.0.1), which reaches a re-joined participant at once");
           join(true);
           ++rejoins;
           lease.restart(wall_seconds());

@@ -56,15 +56,17 @@ int main(int argc, char** argv) {
     // Named, so a log tells which process's files went.
     const auto r = ddswarm::clean_zombie_shm();
     if (r.spared > 0)
-      spdlog::info("left {} unused shared-memory files younger than {} s (a starting "
-                   "participant's, or removed by a later start)",
-                   r.spared, ddswarm::kShmZombieMinAgeS);
+      spdlog::info(
+          "left {} unused shared-memory files younger than {} s (a starting "
+          "participant's, or removed by a later start)",
+          r.spared, ddswarm::kShmZombieMinAgeS);
     if (r.files_removed > 0) {
       constexpr std::size_t kNamed = 6;
       std::string names;
       for (std::size_t i = 0; i < r.removed.size() && i < kNamed; ++i)
         names += (i ? ", " : "") + r.removed[i];
-      if (r.removed.size() > kNamed) names += fmt::format(" and {} more", r.removed.size() - kNamed);
+      if (r.removed.size() > kNamed)
+        names += fmt::format(" and {} more", r.removed.size() - kNamed);
       spdlog::info("removed {} shared-memory files ({:.1f} MB) left by crashed processes: {}",
                    r.files_removed, r.bytes_freed / 1e6, names);
     }

@@ -16,10 +16,15 @@ gs distance -3 >/dev/null 2>&1; [ $? -eq 2 ] || fail "negative distance not reje
 
 start launch "$BIN/ddswarm-launch" "$SRC/tests/scenarios/slow_liveness.yaml" --domain "$DOMAIN"
 gs wait-agents --count 3 --timeout 30 || fail "agents not online"
-# wait-agents that times out says so, and whose view: exit 1.
-out=$(gs wait-agents --count 4 --timeout 1); rc=$?
+# wait-agents shows its progress every 10 s; a timeout says so, and whose
+# view (the server's): exit 1.
+out=$(gs wait-agents --count 4 --timeout 11 2>&1); rc=$?
+echo "$out"
 [ $rc -eq 1 ] || fail "wait-agents for more agents than fly exited $rc: $out"
-echo "$out" | grep -q "the server hears 3 of the 4 agents asked for" || fail "unclear wait-agents timeout: $out"
+echo "$out" | grep -q "waiting for agents: the server hears 3 of 4 after 10 s (of 11 s)" ||
+  fail "no progress from wait-agents: $out"
+echo "$out" | grep -q "timed out after 11 s: the server hears 3 of the 4 agents asked for" ||
+  fail "unclear wait-agents timeout: $out"
 out=$(gs takeoff --wait); rc=$?
 echo "$out"; [ $rc -eq 0 ] || fail "takeoff exited $rc"
 echo "$out" | grep -q "takeoff 3/3 acknowledged" || fail "takeoff not acknowledged by all: $out"
