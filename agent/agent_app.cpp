@@ -577,10 +577,10 @@ struct AgentApp::Impl {
 
   AgentApp::End run(double duration_s) {
     const double joined = wall_seconds();
-    // Up to half as long again, different in every process: when a whole
-    // swarm missed the server, its agents must not all re-join at once.
-    const double patience =
-        cfg.agent.rejoin_after_s * (1.0 + 0.5 * static_cast<double>(brains[0]->instance % 1024) / 1024.0);
+    // Spread by process up to longest_scene_wait_s (AgentConfig::kRejoinSpread).
+    const double patience = cfg.agent.rejoin_after_s *
+                            (1.0 + AgentConfig::kRejoinSpread *
+                                       static_cast<double>(brains[0]->instance % 1024) / 1024.0);
     double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());

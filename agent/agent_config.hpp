@@ -77,6 +77,12 @@ struct AgentConfig {
   double server_timeout_s = 1.0;   ///< s (wall): no server sample this long = server lost (logged once, flagged in heartbeats); > 0
   double rejoin_after_s = 40.0;  ///< s (wall): no scene this long after joining: leave DDS and join
                                  ///< again as a new participant (0 = never)
+  /// A join waits rejoin_after_s for the scene, and up to this share longer,
+  /// different in every process: when a whole swarm missed the server, its
+  /// agents must not all re-join at once.
+  static constexpr double kRejoinSpread = 0.5;
+  /// The longest a first join waits for the scene before joining again.
+  double longest_scene_wait_s() const { return rejoin_after_s * (1.0 + kRejoinSpread); }
   /// Fault injection: the share of the server's swarm-state samples this
   /// agent drops on arrival, as if lost on the way; [0, 0.5]. Real time flies
   /// on the next sample; lockstep waits sim.lockstep_resend_s for the tick again.

@@ -96,6 +96,13 @@ void remove_segment(const std::string& dir, const std::string& name, ShmCleanRep
 
 }  // namespace
 
+std::string ShmCleanReport::removed_names(std::size_t first) const {
+  std::string out;
+  for (std::size_t i = 0; i < removed.size() && i < first; ++i) out += (i ? ", " : "") + removed[i];
+  if (removed.size() > first) out += " and " + std::to_string(removed.size() - first) + " more";
+  return out;
+}
+
 ShmCleanReport clean_zombie_shm(const std::string& dir, double min_age_s) {
   ShmCleanReport r;
   const auto names = list_dir(dir);

@@ -27,6 +27,9 @@ struct ShmCleanReport {
   int in_use = 0;  ///< segments and ports left alone because a live process holds them
   int spared = 0;  ///< unused by every sign but younger than min_age_s: left (maybe being made)
   std::vector<std::string> removed;  ///< the files' names
+
+  /// The first `first` names removed, comma-separated, then "and K more".
+  std::string removed_names(std::size_t first) const;
 };
 
 /// How old a file must be (by its mtime) before it may be a zombie. Fast DDS

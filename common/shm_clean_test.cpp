@@ -129,6 +129,8 @@ TEST(ShmClean, LeavesFilesBeingMadeToTheirMaker) {
   for (const auto& n : names) EXPECT_FALSE(d.has(n)) << n;
   EXPECT_EQ(r.files_removed, 3);
   EXPECT_EQ(r.removed.size(), 3u);
+  EXPECT_EQ(r.removed_names(1), r.removed[0] + " and 2 more");
+  EXPECT_EQ(r.removed_names(6), r.removed[0] + ", " + r.removed[1] + ", " + r.removed[2]);
 }
 
 // A server restarted after a SIGKILL must not come up on its dead

@@ -20,6 +20,7 @@
 #include "common/cli_checks.hpp"
 #include "common/participant.hpp"
 #include "common/process.hpp"
+#include "common/scenario.hpp"
 #include "ground_station/domain_claim.hpp"
 #include "ground_station/experiment_config.hpp"
 #include "ground_station/gs_app.hpp"
@@ -73,20 +74,18 @@ int run_foreground(const std::vector<std::string>& argv, Launcher& procs,
 }
 
 /// How long --gs waits for the agents before its first step: the bring-up,
-/// plus the longest first join of an agent that heard no scene (up to 1.5
-/// agent.rejoin_after_s, agent/agent_app.cpp) and came back as a new
-/// participant. With the default 30 s a launch gave up on an agent cut off at
-/// start-up that would have come back at 40-60 s (mp_comm_task, 2026-11-29).
+/// plus the longest first join of an agent that heard no scene before it came
+/// back as a new participant. With the default 30 s a launch gave up on an
+/// agent cut off at start-up that would have come back at 40-60 s
+/// (mp_comm_task, 2026-11-29).
 double agents_wait_s(const std::string& scenario) {
-  double rejoin = ddswarm::agent::AgentConfig{}.rejoin_after_s;
+  ddswarm::agent::AgentConfig agent;
   try {
-    const YAML::Node root = YamlDocument::load_file(scenario).root();
-    if (root["agent"] && root["agent"]["rejoin_after_s"])
-      rejoin = root["agent"]["rejoin_after_s"].as<double>();
+    load(load_scenario(scenario).section("agent"), agent);
   } catch (const std::exception&) {
-    // The agents name a bad value themselves.
+    agent = {};  // the agents name a bad section themselves
   }
-  return 30.0 + 1.5 * std::max(rejoin, 0.0);
+  return 30.0 + std::max(agent.longest_scene_wait_s(), 0.0);
 }
 
 }  // namespace

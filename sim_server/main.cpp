@@ -4,7 +4,6 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <optional>
-#include <string>
 
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
@@ -60,16 +59,9 @@ int main(int argc, char** argv) {
           "left {} unused shared-memory files younger than {} s (a starting "
           "participant's, or removed by a later start)",
           r.spared, ddswarm::kShmZombieMinAgeS);
-    if (r.files_removed > 0) {
-      constexpr std::size_t kNamed = 6;
-      std::string names;
-      for (std::size_t i = 0; i < r.removed.size() && i < kNamed; ++i)
-        names += (i ? ", " : "") + r.removed[i];
-      if (r.removed.size() > kNamed)
-        names += fmt::format(" and {} more", r.removed.size() - kNamed);
+    if (r.files_removed > 0)
       spdlog::info("removed {} shared-memory files ({:.1f} MB) left by crashed processes: {}",
-                   r.files_removed, r.bytes_freed / 1e6, names);
-    }
+                   r.files_removed, r.bytes_freed / 1e6, r.removed_names(6));
     ddswarm::install_rejoin_signal();
     // A new server each time SIGUSR1 asks before a mission (SimServer::run).
     std::uint64_t rival = 0;
