@@ -98,7 +98,7 @@ struct DroneBrain {
   const int id;
   const std::uint64_t instance = random_instance();
   std::unique_ptr<MissionFsm> fsm;
-  TruthPeerSource truth;
+  TruthPeerSource truth{id};
   std::unique_ptr<ModelledPeerSource> modelled;  // when comm asks for more than exact truth
   PeerSource* peers = &truth;
   std::uint64_t fed_tick = ~0ULL;  // the tick whose truth and beacons the peer source has taken
@@ -111,7 +111,6 @@ struct DroneBrain {
   std::uint64_t rejected = 0, sent = 0;
   std::uint64_t rival = 0;  // another instance heard on this id during the start-up probe
   std::string rival_where;
-  std::vector<PeerObservation> others;
   std::vector<Eigen::Vector3d> ranged;
   std::vector<float> ranges, angles;
   std::vector<std::uint8_t> hits;
@@ -488,9 +487,6 @@ struct AgentApp::Impl {
                    a.accepted ? "accepted" : "rejected", s.tick(), a.accepted ? "" : ": " + a.reason);
     }
 
-    b.others.clear();
-    for (const auto& o : roster)
-      if (o.id != id) b.others.push_back(o);
     // Each tick's truth and beacons go to the peer source once, even when the
     // server re-sends the same tick while it waits.
     const bool new_tick = s.tick() != b.fed_tick;
@@ -499,7 +495,7 @@ struct AgentApp::Impl {
     if (b.modelled) {
       if (new_tick) {
         b.modelled->set_tick(s.tick(), s.sim_time_s(), obs.p_world);
-        b.modelled->on_truth(s.sim_time_s(), b.others);
+        b.modelled->on_truth(s.sim_time_s(), roster);  // skips its own id
         for (const auto& bc : s.beacons()) {
           if (bc.drone_id() == id || bc.drone_id() >= s.drones().size()) continue;
           PeerMessage pm{bc.drone_id(), bc.tick(), bc.stamp_s(), from_msg(bc.position()), from_msg(bc.true_position())};
@@ -508,7 +504,7 @@ struct AgentApp::Impl {
       }
       own_p = b.modelled->channel().noisy_own_position(obs.p_world, s.tick());
     } else if (new_tick) {
-      b.peers->on_truth(s.sim_time_s(), b.others);
+      b.peers->on_truth(s.sim_time_s(), roster);  // skips its own id
     }
 
     MissionOutput out = b.fsm->step(obs);

@@ -128,13 +128,13 @@ void ModelledPeerSource::set_tick(std::uint64_t tick, double t,
   self_p_ = self_true_p;
 }
 
-void ModelledPeerSource::on_truth(double t, std::span<const PeerObservation> others) {
+void ModelledPeerSource::on_truth(double t, std::span<const PeerObservation> swarm) {
   if (t != now_s_) {
     tick_ = static_cast<std::uint64_t>(std::max(0LL, std::llround(t / channel_.tick_s())));
     now_s_ = t;
   }
   if (cfg_.source != PeerSourceType::kTruth) return;
-  for (const auto& o : others) {
+  for (const auto& o : swarm) {
     if (o.id == self_) continue;
     if (!finite(o.p_world)) {
       ++rejected_;

@@ -116,9 +116,10 @@ class CommChannel {
 ///
 /// Per tick k, at sim time t, the application calls:
 ///   set_tick(k, t, own true position);
-///   on_truth(t, others)            every other drone's true position; with
-///                                  source truth each one is sent through the
-///                                  channel, stamped with its sample time;
+///   on_truth(t, swarm)             every drone's true position (its own
+///                                  skipped); with source truth each one is
+///                                  sent through the channel, stamped with
+///                                  its sample time;
 ///   on_beacon(m, ...)              for each beacon received (source beacons;
 ///                                  ignored with truth, and for our own id);
 ///   peers(t) / heard(t)            the peers the law may use.
@@ -145,7 +146,7 @@ class ModelledPeerSource final : public PeerSource {
   /// channel as sent at the current tick. NaN positions are ignored, counted.
   /// A t other than set_tick's starts tick round(t / tick_s) (the server's sim
   /// time is tick × period), keeping the last own position.
-  void on_truth(double t, std::span<const PeerObservation> others) override;
+  void on_truth(double t, std::span<const PeerObservation> swarm) override;
 
   /// A beacon heard from another agent (source beacons). receiver_true_p is
   /// this drone's true position at m.tick_sent. Ignored with source truth and

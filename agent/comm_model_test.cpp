@@ -347,21 +347,23 @@ TEST(CommChannel, EachEffectDrawsFromItsOwnStream) {
 
 TEST(ModelledPeerSource, DefaultsAreANoOp) {
   ModelledPeerSource model(CommConfig{}, 1, 0, kTick);
-  TruthPeerSource truth;
+  TruthPeerSource truth(0);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> step(-0.1, 0.1);
-  std::vector<PeerObservation> others;
-  for (int id = 1; id < 6; ++id) others.push_back({id, {4.0 * id, 1, 2}, 0});
+  // The swarm as an agent hands it to every brain: drone 0's own entry too.
+  std::vector<PeerObservation> swarm;
+  for (int id = 0; id < 6; ++id) swarm.push_back({id, {4.0 * id, 1, 2}, 0});
   for (std::uint64_t k = 0; k < 300; ++k) {
     const double t = static_cast<double>(k) * kTick;
-    for (auto& o : others) {
+    for (auto& o : swarm) {
       o.p_world += Eigen::Vector3d(step(rng), step(rng), step(rng));
       o.stamp_s = t;
     }
-    const Eigen::Vector3d self(step(rng), 0, 2);
+    const Eigen::Vector3d self = swarm[0].p_world;
     model.set_tick(k, t, self);
-    model.on_truth(t, others);
-    truth.on_truth(t, others);
+    model.on_truth(t, swarm);
+    truth.on_truth(t, swarm);
+    ASSERT_EQ(truth.peers(t).size(), 5u) << "its own entry is no peer";
     ASSERT_EQ(model.peers(t), truth.peers(t)) << "tick " << k;  // bit for bit, same tick
     for (const auto& h : model.heard(t)) EXPECT_EQ(h.stamp_s, t);
     EXPECT_EQ(model.channel().noisy_own_position(self, k), self);

@@ -17,8 +17,10 @@ struct PeerObservation {
 class PeerSource {
  public:
   virtual ~PeerSource() = default;
-  /// The server's exact positions of the other drones at sim time t.
-  virtual void on_truth(double t, std::span<const PeerObservation> others) = 0;
+  /// The server's exact positions of the swarm's drones at sim time t. The
+  /// span may hold this drone's own entry too: a source skips its own id, so
+  /// an agent hands every brain the same roster without copying it.
+  virtual void on_truth(double t, std::span<const PeerObservation> swarm) = 0;
   /// Peer positions this drone may use at sim time t.
   virtual const std::vector<Eigen::Vector3d>& peers(double t) = 0;
 };
@@ -26,13 +28,17 @@ class PeerSource {
 /// The thesis's source: the simulator's exact positions, no delay.
 class TruthPeerSource final : public PeerSource {
  public:
-  void on_truth(double, std::span<const PeerObservation> others) override {
+  /// self_id: this drone, whose own entry is no peer.
+  explicit TruthPeerSource(int self_id) : self_(self_id) {}
+  void on_truth(double, std::span<const PeerObservation> swarm) override {
     peers_.clear();
-    for (const auto& o : others) peers_.push_back(o.p_world);
+    for (const auto& o : swarm)
+      if (o.id != self_) peers_.push_back(o.p_world);
   }
   const std::vector<Eigen::Vector3d>& peers(double) override { return peers_; }
 
  private:
+  int self_;
   std::vector<Eigen::Vector3d> peers_;
 };
 

@@ -57,15 +57,31 @@ Eigen::Vector3d repulsion_attraction(const Eigen::Vector3d& self,
       if (const double dist = (p - self).norm(); acts(dist)) c += term(p, dist);
     return c;
   }
-  // The k nearest: (distance, index) of every acting peer, partly sorted.
-  // Ties go to the lower index, so the choice depends on the input alone.
-  thread_local std::vector<std::pair<double, std::size_t>> near;
+  // The k nearest by (squared distance, index), kept in a sorted list of at
+  // most k while the peers are scanned: a peer farther than the k-th kept one
+  // is passed over on its squared distance alone, without a square root. At
+  // 512 drones and k = 6 this scan replaced a partial sort of every peer,
+  // which was the agent host's largest cost (docs/performance.md).
+  // Ties go to the lower index, and the terms are summed nearest first, so
+  // the result depends on the input alone.
+  struct Near {
+    double d2, dist;
+    std::size_t j;
+  };
+  thread_local std::vector<Near> near;
   near.clear();
-  for (std::size_t j = 0; j < peers.size(); ++j)
-    if (const double dist = (peers[j] - self).norm(); acts(dist)) near.emplace_back(dist, j);
-  const std::size_t n = std::min(k, near.size());
-  if (near.size() > n) std::nth_element(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
-  for (std::size_t i = 0; i < n; ++i) c += term(peers[near[i].second], near[i].first);
+  for (std::size_t j = 0; j < peers.size(); ++j) {
+    const double d2 = (peers[j] - self).squaredNorm();
+    // A later peer at an equal squared distance never displaces a kept one.
+    if (near.size() == k && !(d2 < near.back().d2)) continue;
+    const double dist = std::sqrt(d2);  // what .norm() gives, bit for bit
+    if (!acts(dist)) continue;
+    if (near.size() == k) near.pop_back();
+    auto at = std::upper_bound(near.begin(), near.end(), d2,
+                               [](double v, const Near& n) { return v < n.d2; });
+    near.insert(at, Near{d2, dist, j});
+  }
+  for (const Near& n : near) c += term(peers[n.j], n.dist);
   return c;
 }
 

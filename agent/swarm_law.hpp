@@ -53,7 +53,7 @@ double f_rel(double d_r, const ActivationConfig& a);
 /// Peers beyond a.cutoff_m (when > 0) are ignored; a peer at self's position
 /// (closer than 1e-9 m) has no direction and contributes nothing. With
 /// a.neighbours = k > 0 only the k nearest of the remaining peers act (equal
-/// distances: the earlier peer in the span).
+/// distances: the earlier peer in the span), summed nearest first.
 ///
 /// Why k nearest (a topological neighbourhood, as starlings keep about seven
 /// neighbours: Ballerini et al., PNAS 2008): in the thesis's sum every peer

@@ -159,6 +159,37 @@ TEST(RepulsionAttraction, NeighboursTakesOnlyTheKNearestPeers) {
   EXPECT_NEAR(repulsion_attraction(self, tie, 4, a).y(), -1.5, 1e-12);
 }
 
+// The k nearest, found in one pass, are the peers a full sort by (distance,
+// index) puts first, summed in that order: checked bit for bit on clouds of
+// a swarm's size with duplicates, a coincident peer, NaN and a cutoff.
+TEST(RepulsionAttraction, NeighboursMatchTheFullSortBitForBit) {
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-30.0, 30.0);
+  for (int round = 0; round < 40; ++round) {
+    ActivationConfig a;
+    a.neighbours = 1 + round % 12;
+    a.cutoff_m = round % 3 == 0 ? 12.0 : 0.0;
+    const Vector3d self(u(rng), u(rng), 5.0);
+    std::vector<Vector3d> peers;
+    for (int j = 0; j < 511; ++j) peers.emplace_back(u(rng), u(rng), 5.0 + u(rng) / 10);
+    peers[7] = self;                             // coincident: acts not at all
+    peers[30] = self + Vector3d(1.5, 0.5, 0.0);  // among the nearest, and tied:
+    peers[40] = peers[30];                       // the earlier one first
+    peers[20] = self + Vector3d(-1.5, -0.5, 0.0);
+    peers[100] = Vector3d(std::nan(""), 0, 0);
+    std::vector<std::pair<double, std::size_t>> ref;
+    for (std::size_t j = 0; j < peers.size(); ++j) {
+      const double d = (peers[j] - self).norm();
+      if (d > 1e-9 && !(a.cutoff_m > 0 && d > a.cutoff_m)) ref.emplace_back(d, j);
+    }
+    std::sort(ref.begin(), ref.end());
+    Vector3d want = Vector3d::Zero();
+    for (std::size_t i = 0; i < std::min<std::size_t>(ref.size(), a.neighbours); ++i)
+      want += f_rel(ref[i].first - 4.0, a) * ((peers[ref[i].second] - self) / ref[i].first);
+    EXPECT_EQ(repulsion_attraction(self, peers, 4.0, a), want) << "round " << round;
+  }
+}
+
 namespace {
 
 struct Packing {
