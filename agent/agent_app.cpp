@@ -196,10 +196,11 @@ struct AgentApp::Impl {
                            : "agent host (" + std::to_string(ids.size()) + " drones)";
   }
 
-  /// The agent's shared-memory outbox is sized for the drones it flies.
+  /// The agent's shared-memory outbox and port are sized for the drones it flies.
   static DdsConfig dds_for(const AgentAppConfig& c) {
     DdsConfig d = c.dds;
     d.shm_segment_bytes = agent_shm_segment_bytes(c.drone_ids.size());
+    d.shm_port_queue = agent_shm_port_queue(c.drone_ids.size());
     return d;
   }
 

@@ -82,9 +82,10 @@ DdsConfig dds_for(int domain, const std::string& server, int participant_id = -1
 /// Responder: answers every SwarmState with one VelocityCommand, inside the callback.
 int respond(int id, int domain, const std::string& server, double duration_s, int participant_id) {
   install_stop_signals();
-  // An agent's shared-memory outbox, as ddswarm-agent sizes it for one drone.
+  // An agent's shared-memory outbox and inbox, as ddswarm-agent sizes them for one drone.
   DdsConfig dds = dds_for(domain, server, participant_id);
   dds.shm_segment_bytes = agent_shm_segment_bytes(1);
+  dds.shm_port_queue = agent_shm_port_queue(1);
   Participant p(dds, "dds_floor responder " + std::to_string(id));
   auto w = p.writer<msg::VelocityCommand>();
   msg::VelocityCommand cmd;

@@ -63,6 +63,10 @@ std::uint32_t agent_shm_segment_bytes(std::size_t drones) {
   return static_cast<std::uint32_t>(std::min<std::size_t>(bytes, kShmSegmentBytes));
 }
 
+std::uint32_t agent_shm_port_queue(std::size_t drones) {
+  return static_cast<std::uint32_t>(std::clamp<std::size_t>(16 * drones, 512, kShmPortQueue));
+}
+
 DdsConfig one_shot(DdsConfig c) {
   if (!(c.announcement_period_s > 0.0)) c.announcement_period_s = c.lease_duration_s / 3.0;
   c.lease_duration_s = std::max(c.lease_duration_s, kOneShotLeaseS);

@@ -184,6 +184,7 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
   if (uses_shm_transport(cfg)) {
     auto shm = std::make_shared<SharedMemTransportDescriptor>();
     shm->segment_size(cfg.shm_segment_bytes);
+    shm->port_queue_capacity(cfg.shm_port_queue);
     shm->healthy_check_timeout_ms(
         static_cast<uint32_t>(std::lround(cfg.shm_health_check_s * 1000.0)));
     qos.transport().user_transports.push_back(shm);

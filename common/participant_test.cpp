@@ -108,6 +108,66 @@ TEST(Participant, ReliableWriterServesBestEffortAndReliableReaders) {
   recorder.close();
 }
 
+// 512 drones in 2 agent hosts send the server 512 commands in a few
+// milliseconds each tick. A burst of commands into a server whose receive
+// thread is busy waits on both sides of the shared-memory transport: in the
+// server's port, and in the host's outbox, which Fast DDS 2.9 lets hold as
+// many samples as the host's own port. Fast DDS's default of 512 messages on
+// either side drops the rest (best-effort commands from a reliable writer, as
+// the swarm flies with dds.best_effort_streams); ddswarm's sizes hold it.
+int commands_through_a_stall(std::uint32_t server_port_queue, std::uint32_t host_port_queue,
+                             int burst) {
+  std::atomic<int> got{0};  // outlives the participants' callbacks
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  DdsConfig server_cfg = cfg;
+  server_cfg.shm_port_queue = server_port_queue;
+  DdsConfig host_cfg = cfg;
+  host_cfg.shm_segment_bytes = agent_shm_segment_bytes(256);
+  host_cfg.shm_port_queue = host_port_queue;
+  Participant server(server_cfg, "participant_test server");
+  Participant host(host_cfg, "participant_test agent host");
+  auto w = host.writer<msg::VelocityCommand>();
+  auto& r = server.reader<msg::VelocityCommand>(
+      [&](const msg::VelocityCommand&, const fdds::SampleInfo&) {
+        // Descheduled on the first command, while the burst comes.
+        if (++got == 1) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      },
+      std::nullopt, Delivery::kLatest);
+  if (!within(10, [&] { return w.matched() == 1 && r.matched() == 1; })) return -1;
+  msg::VelocityCommand c;
+  for (int k = 1; k <= burst; ++k) {
+    c.drone_id(static_cast<std::uint16_t>(k % 256));
+    c.tick(static_cast<std::uint64_t>(k));
+    w.write(c);
+  }
+  // Until every command is in, or none has come for 0.5 s after the stall.
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  for (int quiet = 0, last = -1; quiet < 5 && got.load() < burst; last = got.load()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    quiet = got.load() == last ? quiet + 1 : 0;
+  }
+  server.close();
+  host.close();
+  return got.load();
+}
+
+TEST(Participant, ABurstOfCommandsThroughAStallOfTheServerArrivesWhole) {
+  constexpr int kBurst = 2000;
+  const std::uint32_t host = agent_shm_port_queue(256);
+  EXPECT_EQ(commands_through_a_stall(kShmPortQueue, host, kBurst), kBurst);
+  const int small_server = commands_through_a_stall(512, host, kBurst);
+  const int small_host = commands_through_a_stall(kShmPortQueue, 512, kBurst);
+  EXPECT_GT(small_server, 0) << "the participants did not match";
+  EXPECT_LT(small_server, kBurst) << "a server port of 512 messages held the burst";
+  EXPECT_GT(small_host, 0) << "the participants did not match";
+  EXPECT_LT(small_host, kBurst) << "a host outbox of 512 samples held the burst";
+  std::printf(
+      "a burst of %d commands through a 500 ms stall: %d with a server port of 512, "
+      "%d with a host port (outbox) of 512\n",
+      kBurst, small_server, small_host);
+}
+
 // The recorder must keep every sample a writer sends, even when it is
 // descheduled. A data-sharing writer (KEEP_LAST 4) reuses a sample's pool slot
 // four samples later whether or not a reader has read it; Delivery::kArchive
