@@ -81,7 +81,7 @@ std::uint32_t agent_shm_segment_bytes(std::size_t drones);
 /// transport waits for the process's receive thread. Fast DDS 2.9 also lets a
 /// process's outbox (its segment) hold only as many samples in flight as its
 /// own port holds. Past either, samples are dropped, reliable or not, and
-/// Fast DDS says nothing. Its default is 512. 512 drones in 2 agent hosts
+/// Fast DDS says nothing. Fast DDS's default is 512. 512 drones in 2 agent hosts
 /// send the server 512 commands in a few milliseconds each tick: with 512 on
 /// every side the server lost 0.07-0.20 % of them in every run, and none with
 /// 4,096 or more (docs/performance.md). A message takes 25 bytes: 8,192 make
