@@ -85,7 +85,8 @@ std::uint32_t agent_shm_segment_bytes(std::size_t drones);
 /// send the server 512 commands in a few milliseconds each tick: with 512 on
 /// every side the server lost 0.07-0.20 % of them in every run, and none with
 /// 4,096 or more (docs/performance.md). A message takes 25 bytes: 8,192 make
-/// a 206 KB port, two per participant.
+/// a 206 KB port, two per participant, and the outbox's table of as many
+/// buffers adds 384 KiB to the segment.
 constexpr std::uint32_t kShmPortQueue = 8192;
 
 /// An agent process's port, and so the samples its outbox holds in flight:
