@@ -1,10 +1,10 @@
 // ddswarm-launch: starts the server and one agent process per drone (and
 // optionally ground-station commands), prefixes their logs, supervises them.
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <ctime>
 #include <filesystem>
