@@ -31,6 +31,15 @@ using namespace ddswarm::gs;
 
 namespace {
 
+/// ground_station.discovery_timeout_s in a swarm for which the launcher starts
+/// a discovery server, unless its scenario names one. A ground station that
+/// hears no server through a discovery server joins again after 20 s; at the
+/// default 10 s it would give up first. Restarted after a crash, the
+/// discovery server knows a participant again only when that participant's
+/// lease of the old one lapses (docs/faults.md), and a ground station that
+/// joined meanwhile needs its own re-join.
+constexpr double kDiscoveryServerGsTimeoutS = 60.0;
+
 std::vector<std::string> split_script(const std::string& s) {
   std::vector<std::string> out;
   std::stringstream ss(s);
@@ -222,16 +231,29 @@ int main(int argc, char** argv) {
     if (wants_local_discovery_server(ds, participants, only == "all" && ids_text.empty(), localhost_discovery)) {
       // First, so every participant finds it; clients retry until it answers.
       const int port = free_udp_port();
-      procs.start(discovery_server_spec(port));
+      const ChildSpec ds_spec = discovery_server_spec(port);
+      procs.start(ds_spec);
+      death_policy.always_restart(ds_spec);  // on the same port: every client finds it again
       procs.rejoin_dropped_participants("discovery-server");
       // A longer lease for the swarm's own participants, unless the scenario
       // names one: under a 128-process bring-up the discovery server, short of
       // CPU, drops datagrams, and at the default 3 s it let the server's lease
       // lapse and lost it for good (docs/performance.md).
+      // And ground stations patient enough for their own re-join through it
+      // (ground_station/main.cpp: after 20 s without a server), which also
+      // carries them over a restart of the discovery server (docs/faults.md).
       const YAML::Node root = YamlDocument::load_file(scenario).root();
+      std::map<std::string, YAML::Node> for_ds;
       if (!(root["dds"] && root["dds"]["lease_duration_s"]))
-        derive({{"dds.lease_duration_s", YAML::Node(kDiscoveryServerLeaseS)}},
-               fmt::format("dds.lease_duration_s: {} (a discovery server)", kDiscoveryServerLeaseS));
+        for_ds["dds.lease_duration_s"] = YAML::Node(kDiscoveryServerLeaseS);
+      if (!(root["ground_station"] && root["ground_station"]["discovery_timeout_s"]))
+        for_ds["ground_station.discovery_timeout_s"] = YAML::Node(kDiscoveryServerGsTimeoutS);
+      if (!for_ds.empty()) {
+        std::string why;
+        for (const auto& [key, value] : for_ds)
+          why += fmt::format("{}{}: {}", why.empty() ? "" : ", ", key, value.as<std::string>());
+        derive(for_ds, why + " (a discovery server)");
+      }
       const std::string address = "127.0.0.1:" + std::to_string(port);
       dds_args.push_back("--discovery-server");
       dds_args.push_back(address);

@@ -378,9 +378,11 @@ OnDeath parse_on_death(const std::string& text) {
 }
 
 std::optional<ChildSpec> DeathPolicy::ended(const ChildExit& e) {
-  const auto spec = restartable_.find(e.name);
-  if (policy_ == OnDeath::kRestart && spec != restartable_.end() && worth_restarting(e) &&
-      restarts_[e.name] < kMaxRestarts) {
+  const auto always = always_.find(e.name);
+  const auto spec = always != always_.end() ? always : restartable_.find(e.name);
+  const bool may =
+      always != always_.end() || (policy_ == OnDeath::kRestart && spec != restartable_.end());
+  if (may && worth_restarting(e) && restarts_[e.name] < kMaxRestarts) {
     ++restarts_[e.name];
     return spec->second;
   }

@@ -47,6 +47,9 @@ constexpr int kMaxRestarts = 3;
 /// kStop: stop everything. kKeep: report it and keep flying. kRestart: start
 /// a restartable process (an agent) again when worth_restarting says it can
 /// mend, up to kMaxRestarts times each; any other end stops everything.
+/// Whatever the policy, the launcher's own discovery server is started again
+/// on a crash (DeathPolicy::always_restart): it flies no drone, and Fast DDS
+/// 2.9.1's fast-discovery-server can abort on an assertion (docs/faults.md).
 enum class OnDeath { kStop, kKeep, kRestart };
 /// "stop", "keep" or "restart"; throws std::invalid_argument naming the value.
 OnDeath parse_on_death(const std::string& text);
@@ -59,6 +62,9 @@ class DeathPolicy {
   explicit DeathPolicy(OnDeath policy) : policy_(policy) {}
   /// A process that kRestart may start again (the launcher's agents).
   void restartable(const ChildSpec& spec) { restartable_[spec.name] = spec; }
+  /// A process started again whatever the policy, when worth_restarting says
+  /// it can mend, up to kMaxRestarts times (the launcher's discovery server).
+  void always_restart(const ChildSpec& spec) { always_[spec.name] = spec; }
   /// A child ended: the spec to start again, or nothing (it died).
   std::optional<ChildSpec> ended(const ChildExit& e);
   /// Some child ended and was not started again.
@@ -71,6 +77,7 @@ class DeathPolicy {
  private:
   OnDeath policy_;
   std::map<std::string, ChildSpec> restartable_;
+  std::map<std::string, ChildSpec> always_;
   std::map<std::string, int> restarts_;
   bool died_ = false;
 };

@@ -212,6 +212,27 @@ TEST(DeathPolicy, StopStopsAtTheFirstDeathAndKeepNever) {
   EXPECT_FALSE(keep.stop());
 }
 
+TEST(DeathPolicy, RestartsACrashedDiscoveryServerWhateverThePolicy) {
+  const ChildSpec ds{"discovery-server", {"/usr/bin/fast-discovery-server", "-p", "4242"}};
+  for (OnDeath policy : {OnDeath::kStop, OnDeath::kKeep, OnDeath::kRestart}) {
+    DeathPolicy p(policy);
+    p.always_restart(ds);
+    const ChildExit abort{"discovery-server", 11, -1, SIGABRT};  // Fast DDS 2.9.1's assertion
+    for (int k = 1; k <= kMaxRestarts; ++k) {
+      const auto again = p.ended(abort);
+      ASSERT_TRUE(again.has_value()) << "restart " << k;
+      EXPECT_EQ(again->argv, ds.argv) << "the same port, so every client finds it again";
+      EXPECT_FALSE(p.stop());
+    }
+    EXPECT_FALSE(p.ended(abort).has_value()) << "a server that keeps dying is a death";
+    EXPECT_EQ(p.stop(), policy != OnDeath::kKeep);
+  }
+  DeathPolicy clean_exit(OnDeath::kStop);
+  clean_exit.always_restart(ds);
+  EXPECT_FALSE(clean_exit.ended({"discovery-server", 12, 0, 0}).has_value());
+  EXPECT_TRUE(clean_exit.stop());
+}
+
 TEST(DeathPolicy, ParsesTheOptionAndNamesABadValue) {
   EXPECT_EQ(parse_on_death("stop"), OnDeath::kStop);
   EXPECT_EQ(parse_on_death("keep"), OnDeath::kKeep);
