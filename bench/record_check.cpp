@@ -3,6 +3,7 @@
 // for keyed topics). Exit 1 when a stream has a gap (a dropped sample).
 #include <cstdio>
 #include <map>
+#include <numeric>
 #include <set>
 
 #include "common/mcap/mcap_reader.hpp"
@@ -25,7 +26,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   mcap::Reader r(argv[1]);
-  struct Stream { std::uint64_t first = 0, last = 0, n = 0; };
+  // step: the gcd of every tick's distance from the first, so a stream sent
+  // every k-th tick (scans at a sensor rate below the control rate) counts
+  // only the ticks it would have sent as gaps.
+  struct Stream { std::uint64_t first = 0, last = 0, n = 0, step = 0; };
   std::map<std::string, std::map<int, Stream>> ticks;  // topic -> drone (-1: whole swarm) -> ticks
   std::map<std::string, std::uint64_t> count, bytes;
   std::uint64_t t0 = ~0ULL, t1 = 0;
@@ -38,6 +42,7 @@ int main(int argc, char** argv) {
     auto note = [&](int key, std::uint64_t tick) {
       auto& s = ticks[topic][key];
       if (s.n == 0) s.first = tick;
+      s.step = std::gcd(s.step, tick > s.first ? tick - s.first : s.first - tick);
       s.last = std::max(s.last, tick);
       ++s.n;
     };
@@ -60,7 +65,7 @@ int main(int argc, char** argv) {
     std::uint64_t missing = 0;
     for (const auto& [key, s] : ticks[topic]) {
       // Republished ticks (lockstep waits) can repeat; a gap is a tick never seen.
-      const std::uint64_t span = s.last - s.first + 1;
+      const std::uint64_t span = s.step == 0 ? 1 : (s.last - s.first) / s.step + 1;
       if (s.n < span) missing += span - s.n;
     }
     gap |= missing > 0;
@@ -71,5 +76,9 @@ int main(int argc, char** argv) {
   }
   std::printf("%-24s %10llu %12.0f %10.2f   over %.1f s (%s)\n", "total", static_cast<unsigned long long>(total),
               total / dur, total_bytes / dur / 1e6, dur, r.how_read().describe().c_str());
+  if (total == 0) {
+    std::fprintf(stderr, "record_check: %s holds no message\n", argv[1]);
+    return 1;
+  }
   return gap ? 1 : 0;
 }
