@@ -255,6 +255,24 @@ TEST(Participant, SwarmStateUsesSharedMemoryOnlyWhenAllowed) {
   local.close();
 }
 
+// Fast DDS's periodic heartbeat of a reliable writer notifies every
+// data-sharing reader on the event thread, where a killed reader's held lock
+// throws past every catch and ends the process (docs/dds.md). The swarm
+// state's writer, the one data-sharing writer, must not send it within a
+// killed agent's lease: its period outlasts the longest lease ddswarm gives.
+TEST(Participant, TheSwarmStateHeartbeatOutlastsEveryLease) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant p(cfg, "participant_test");
+  auto w = p.writer<msg::SwarmState>();
+  const auto hb = w.raw()->get_qos().reliable_writer_qos().times.heartbeatPeriod;
+  EXPECT_GE(hb.seconds, 10 * static_cast<int>(kDiscoveryServerLeaseS)) << "s";
+  // The other reliable writers keep Fast DDS's: no data-sharing reader to reach.
+  auto c = p.writer<msg::VelocityCommand>();
+  EXPECT_EQ(c.raw()->get_qos().reliable_writer_qos().times.heartbeatPeriod.seconds, 3);
+  p.close();
+}
+
 // An agent tells a live server from one that was away by when the server's
 // writer was matched again: matched_since() moves only when the count rises
 // from none.
