@@ -45,6 +45,12 @@ class SafePubSub : public Generated {
   }
 };
 
+/// The swarm state, which every agent reads every tick, decodes inline
+/// (decode_swarm_state in common/swarm_state_cdr.hpp), to the same sample.
+template <>
+bool SafePubSub<msg::SwarmStatePubSubType>::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
+                                                        void* data);
+
 template <class T>
 struct Topic;
 
