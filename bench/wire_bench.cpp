@@ -4,13 +4,12 @@
 // scan of 8 rays, as in the bench scenario. Prints µs per sample, bytes per
 // second, and on each inline row the ratio x_faster (generated ÷ inline).
 #include <benchmark/benchmark.h>
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
 
 #include <chrono>
 #include <random>
 #include <vector>
-
-#include <fastcdr/Cdr.h>
-#include <fastcdr/FastBuffer.h>
 
 #include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
@@ -79,7 +78,8 @@ double mean_us(F&& decode, int reps) {
   decode();
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < reps; ++k) decode();
-  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() / reps;
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() /
+         reps;
 }
 
 void BM_DecodeInline(benchmark::State& state) {
@@ -92,7 +92,8 @@ void BM_DecodeInline(benchmark::State& state) {
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * w.payload.length);
   // The ratio, measured side by side here: generated µs / inline µs.
   const double gen = mean_us([&] { w.type.deserialize(&w.payload, &out); }, 500);
-  const double fast = mean_us([&] { decode_swarm_state(w.payload.data, w.payload.length, out); }, 500);
+  const double fast =
+      mean_us([&] { decode_swarm_state(w.payload.data, w.payload.length, out); }, 500);
   state.counters["x_faster"] = gen / fast;
 }
 

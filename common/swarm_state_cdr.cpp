@@ -1,9 +1,9 @@
 #include "common/swarm_state_cdr.hpp"
 
 #include <bit>
-#include <type_traits>
 #include <cstring>
 #include <string>
+#include <type_traits>
 
 #include "common/topics.hpp"
 
@@ -183,8 +183,8 @@ bool decode_swarm_state(const std::uint8_t* data, std::size_t size, msg::SwarmSt
 namespace ddswarm {
 
 template <>
-bool SafePubSub<msg::SwarmStatePubSubType>::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
-                                                        void* data) {
+bool SafePubSub<msg::SwarmStatePubSubType>::deserialize(
+    eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) {
   if (decode_swarm_state(payload->data, payload->length, *static_cast<msg::SwarmState*>(data))) {
     payload->encapsulation = (payload->data[1] & 0x1) ? CDR_LE : CDR_BE;
     return true;

@@ -3,6 +3,9 @@
 // the generated code would refuse or that break the IDL's bounds.
 #include "common/swarm_state_cdr.hpp"
 
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
+#include <fastcdr/exceptions/Exception.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,10 +15,6 @@
 #include <random>
 #include <string>
 #include <vector>
-
-#include <fastcdr/Cdr.h>
-#include <fastcdr/FastBuffer.h>
-#include <fastcdr/exceptions/Exception.h>
 
 #include "common/topics.hpp"
 
@@ -65,8 +64,9 @@ void expect_same(const msg::SwarmState& a, const msg::SwarmState& b, const std::
 msg::SwarmState random_state(std::mt19937& rng, int drones) {
   std::uniform_real_distribution<double> u(-1e3, 1e3);
   std::uniform_int_distribution<int> byte(0, 255);
-  const double specials[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
-                             -0.0, std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min()};
+  const double specials[] = {
+      std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), -0.0,
+      std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min()};
   auto value = [&] { return rng() % 17 == 0 ? specials[rng() % 5] : u(rng); };
   auto vec = [&] {
     msg::Vec3 v;
@@ -160,7 +160,8 @@ TEST(SwarmStateCdr, DecodesWhatTheGeneratedCodeDecodesInEitherByteOrder) {
         const auto gen = generated(bytes);
         ASSERT_TRUE(gen.has_value()) << drones << " drones";
         const auto fast = inline_decoded(bytes);
-        ASSERT_TRUE(fast.has_value()) << drones << " drones, " << (big ? "big" : "little") << " endian";
+        ASSERT_TRUE(fast.has_value())
+            << drones << " drones, " << (big ? "big" : "little") << " endian";
         expect_same(*fast, *gen, std::to_string(drones) + " drones");
         expect_same(*fast, s, "the sample sent");
         ++checked;
@@ -174,7 +175,8 @@ TEST(SwarmStateCdr, RefusesEveryTruncation) {
   std::mt19937 rng(7);
   const auto bytes = encode(random_state(rng, 6));
   for (std::size_t n = 0; n < bytes.size(); ++n) {
-    const std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+    const std::vector<std::uint8_t> cut(bytes.begin(),
+                                        bytes.begin() + static_cast<std::ptrdiff_t>(n));
     EXPECT_FALSE(inline_decoded(cut).has_value()) << n << " of " << bytes.size() << " bytes";
     EXPECT_FALSE(generated(cut).has_value()) << n << " of " << bytes.size() << " bytes (generated)";
   }
@@ -196,7 +198,8 @@ TEST(SwarmStateCdr, WhatItAcceptsFromCorruptBytesTheGeneratedCodeReadsAlike) {
     }
     ++accepted;
     const auto gen = generated(bytes);
-    ASSERT_TRUE(gen.has_value()) << "trial " << trial << ": accepted bytes the generated code refuses";
+    ASSERT_TRUE(gen.has_value()) << "trial " << trial
+                                 << ": accepted bytes the generated code refuses";
     expect_same(*fast, *gen, "trial " + std::to_string(trial));
   }
   EXPECT_GT(accepted, 1000);  // most flips land in values, which decode

@@ -6,14 +6,13 @@
 // Invariants: decoding never crashes, reads past the buffer or leaks; a
 // sample it accepts has no sequence beyond its IDL bound, and the generated
 // code accepts the same bytes and reads the same sample from them.
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
+#include <fastcdr/exceptions/Exception.h>
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cstring>
 #include <vector>
-
-#include <fastcdr/Cdr.h>
-#include <fastcdr/FastBuffer.h>
-#include <fastcdr/exceptions/Exception.h>
 
 #include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
@@ -25,9 +24,12 @@ namespace {
 
 std::vector<std::uint8_t> encode(const msg::SwarmState& s, bool big_endian) {
   msg::SwarmStatePubSubType t;
-  eprosima::fastrtps::rtps::SerializedPayload_t p(t.getSerializedSizeProvider(const_cast<msg::SwarmState*>(&s))());
+  eprosima::fastrtps::rtps::SerializedPayload_t p(
+      t.getSerializedSizeProvider(const_cast<msg::SwarmState*>(&s))());
   eprosima::fastcdr::FastBuffer buf(reinterpret_cast<char*>(p.data), p.max_size);
-  eprosima::fastcdr::Cdr cdr(buf, big_endian ? eprosima::fastcdr::Cdr::BIG_ENDIANNESS : eprosima::fastcdr::Cdr::LITTLE_ENDIANNESS,
+  eprosima::fastcdr::Cdr cdr(buf,
+                             big_endian ? eprosima::fastcdr::Cdr::BIG_ENDIANNESS
+                                        : eprosima::fastcdr::Cdr::LITTLE_ENDIANNESS,
                              eprosima::fastcdr::Cdr::DDS_CDR);
   cdr.serialize_encapsulation();
   s.serialize(cdr);
@@ -103,10 +105,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   msg::SwarmState fast;
   if (!decode_swarm_state(bytes.data(), bytes.size(), fast)) return 0;
-  FUZZ_CHECK(fast.drones().size() <= 1024 && fast.scans().size() <= 1024 && fast.beacons().size() <= 1024 &&
-             fast.recent_commands().size() <= 8);
+  FUZZ_CHECK(fast.drones().size() <= 1024 && fast.scans().size() <= 1024 &&
+             fast.beacons().size() <= 1024 && fast.recent_commands().size() <= 8);
   for (const auto& sc : fast.scans())
-    FUZZ_CHECK(sc.angle_body_rad().size() <= 64 && sc.range_m().size() <= 64 && sc.hit().size() <= 64);
+    FUZZ_CHECK(sc.angle_body_rad().size() <= 64 && sc.range_m().size() <= 64 &&
+               sc.hit().size() <= 64);
   // The generated code reads the same bytes to the same sample.
   msg::SwarmStatePubSubType generated;
   eprosima::fastrtps::rtps::SerializedPayload_t p(static_cast<std::uint32_t>(bytes.size()));
