@@ -1,5 +1,8 @@
 #include "common/swarm_state_cdr.hpp"
 
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
+
 #include <bit>
 #include <cstring>
 #include <string>
@@ -176,6 +179,20 @@ bool decode_swarm_state(const std::uint8_t* data, std::size_t size, msg::SwarmSt
   read_structs(in, out.recent_commands(), 8);
   read_structs(in, out.beacons(), 1024);
   return in.ok();
+}
+
+std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian) {
+  msg::SwarmStatePubSubType type;
+  eprosima::fastrtps::rtps::SerializedPayload_t p(
+      type.getSerializedSizeProvider(const_cast<msg::SwarmState*>(&s))());
+  eprosima::fastcdr::FastBuffer buf(reinterpret_cast<char*>(p.data), p.max_size);
+  eprosima::fastcdr::Cdr cdr(buf,
+                             big_endian ? eprosima::fastcdr::Cdr::BIG_ENDIANNESS
+                                        : eprosima::fastcdr::Cdr::LITTLE_ENDIANNESS,
+                             eprosima::fastcdr::Cdr::DDS_CDR);
+  cdr.serialize_encapsulation();
+  s.serialize(cdr);
+  return {p.data, p.data + cdr.getSerializedDataLength()};
 }
 
 }  // namespace ddswarm
