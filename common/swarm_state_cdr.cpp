@@ -27,7 +27,8 @@ class CdrIn {
     align(sizeof(T));
     if (!take(sizeof(T))) return;
     std::memcpy(&v, p_ + pos_ - sizeof(T), sizeof(T));
-    if (swap_ && sizeof(T) > 1) v = swapped(v);
+    if constexpr (sizeof(T) > 1)
+      if (swap_) v = swapped(v);
   }
   /// n values of T, contiguous after one alignment (a C array or a sequence's elements).
   template <class T>
@@ -36,8 +37,9 @@ class CdrIn {
     align(sizeof(T));
     if (!take(sizeof(T) * n)) return;
     std::memcpy(v, p_ + pos_ - sizeof(T) * n, sizeof(T) * n);
-    if (swap_ && sizeof(T) > 1)
-      for (std::size_t k = 0; k < n; ++k) v[k] = swapped(v[k]);
+    if constexpr (sizeof(T) > 1)
+      if (swap_)
+        for (std::size_t k = 0; k < n; ++k) v[k] = swapped(v[k]);
   }
   /// A sequence's length, refused above its IDL bound.
   std::uint32_t length(std::uint32_t bound) {
@@ -66,6 +68,7 @@ class CdrIn {
   }
   template <class T>
   static T swapped(T v) {
+    static_assert(sizeof(T) == 2 || sizeof(T) == 4 || sizeof(T) == 8);
     using U = std::conditional_t<sizeof(T) == 2, std::uint16_t,
                                  std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>;
     U u;
