@@ -233,7 +233,7 @@ int main(int argc, char** argv) {
       const int port = free_udp_port();
       const ChildSpec ds_spec = discovery_server_spec(port);
       procs.start(ds_spec);
-      death_policy.always_restart(ds_spec);  // on the same port: every client finds it again
+      death_policy.always_restart(ds_spec);  // on the same port: the address its clients were given
       procs.rejoin_dropped_participants("discovery-server");
       // A longer lease for the swarm's own participants, unless the scenario
       // names one: under a 128-process bring-up the discovery server, short of
