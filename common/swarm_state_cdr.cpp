@@ -171,8 +171,10 @@ void read_structs(CdrIn& in, std::vector<T>& v, std::uint32_t bound) {
 
 bool decode_swarm_state(const std::uint8_t* data, std::size_t size, msg::SwarmState& out) {
   if (size < 4) return false;
-  // Encapsulation: byte 1 bit 0 is the byte order (1: little endian); the
-  // rest (parameter-list flag, options) the generated code reads and ignores.
+  // Encapsulation: byte 0 is zero; byte 1 bit 0 is the byte order (1: little
+  // endian), bit 1 the parameter-list flag. Fast CDR refuses anything else
+  // there, and reads and ignores the options (bytes 2-3).
+  if (data[0] != 0 || (data[1] & ~0x3) != 0) return false;
   const bool little = (data[1] & 0x1) != 0;
   CdrIn in(data + 4, size - 4, little != (std::endian::native == std::endian::little));
   in.get(out.tick());

@@ -191,6 +191,25 @@ TEST(SwarmStateCdr, WhatItAcceptsFromCorruptBytesTheGeneratedCodeReadsAlike) {
   EXPECT_GT(refused, 0);      // some land in lengths
 }
 
+// Found by fuzz_swarm_state: an encapsulation kind with a bit beyond byte
+// order and parameter list, which Fast CDR refuses ("Unexpected CDR type"),
+// as it does a first byte other than zero.
+TEST(SwarmStateCdr, ReadsTheEncapsulationAsFastCdrDoes) {
+  std::mt19937 rng(13);
+  const auto clean = encode_swarm_state(random_state(rng, 2));
+  for (int kind = 0; kind < 256; ++kind) {
+    for (int first : {0x00, 0xcf}) {
+      auto bytes = clean;
+      bytes[0] = static_cast<std::uint8_t>(first);
+      bytes[1] = static_cast<std::uint8_t>(kind);
+      const auto fast = inline_decoded(bytes);
+      const auto gen = generated(bytes);
+      EXPECT_EQ(fast.has_value(), gen.has_value()) << "encapsulation " << first << " " << kind;
+      if (fast && gen) expect_same(*fast, *gen, "encapsulation " + std::to_string(kind));
+    }
+  }
+}
+
 TEST(SwarmStateCdr, RefusesASequenceBeyondItsBound) {
   std::mt19937 rng(3);
   msg::SwarmState s = random_state(rng, 1);
