@@ -4,13 +4,10 @@
 // scan of 8 rays, as in the bench scenario. Prints µs per sample, bytes per
 // second, and on each inline row the ratio x_faster (generated ÷ inline).
 #include <benchmark/benchmark.h>
-#include <fastcdr/Cdr.h>
-#include <fastcdr/FastBuffer.h>
 
 #include <chrono>
-#include <random>
-#include <vector>
 
+#include "bench/swarm_sample.hpp"
 #include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
 
@@ -19,42 +16,9 @@ using Payload = eprosima::fastrtps::rtps::SerializedPayload_t;
 
 namespace {
 
-msg::SwarmState swarm(int n) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-50, 50);
-  auto vec = [&] {
-    msg::Vec3 v;
-    v.x(u(rng));
-    v.y(u(rng));
-    v.z(u(rng));
-    return v;
-  };
-  msg::SwarmState s;
-  s.tick(123456);
-  s.sim_time_s(2469.12);
-  for (int i = 0; i < n; ++i) {
-    msg::DroneState d;
-    d.drone_id(static_cast<std::uint16_t>(i));
-    d.tick(123456);
-    d.position(vec());
-    d.velocity(vec());
-    d.angular_velocity(vec());
-    s.drones().push_back(d);
-    msg::DistanceScan sc;
-    sc.drone_id(static_cast<std::uint16_t>(i));
-    sc.max_range_m(6);
-    for (int k = 0; k < 8; ++k) {
-      sc.angle_body_rad().push_back(0.785f * static_cast<float>(k));
-      sc.range_m().push_back(static_cast<float>(u(rng) + 50) / 20);
-      sc.hit().push_back(k % 2);
-    }
-    s.scans().push_back(sc);
-  }
-  return s;
-}
-
 struct Wire {
-  explicit Wire(int n) : sample(swarm(n)), payload(type.getSerializedSizeProvider(&sample)()) {
+  explicit Wire(int n)
+      : sample(bench_swarm(n, 8)), payload(type.getSerializedSizeProvider(&sample)()) {
     type.serialize(&sample, &payload);
   }
   msg::SwarmState sample;
