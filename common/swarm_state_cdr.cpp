@@ -5,7 +5,6 @@
 
 #include <bit>
 #include <cstring>
-#include <string>
 #include <type_traits>
 
 #include "common/topics.hpp"
@@ -49,14 +48,17 @@ class CdrIn {
     return ok_ ? len : 0;
   }
   /// A string as Fast CDR reads it (length with the terminator, then the
-  /// bytes), assigned as the generated code does: up to its first NUL.
-  std::string string() {
+  /// bytes), assigned as the generated code does: up to its first NUL, and
+  /// at most the fixed string's size. No copy on the heap: this runs for
+  /// every recent command in every agent every tick.
+  template <std::size_t N>
+  void string(eprosima::fastrtps::fixed_string<N>& out) {
     std::uint32_t len = 0;
     get(len);
-    if (!ok_ || len == 0) return {};
-    if (!take(len)) return {};
+    out = "";
+    if (!ok_ || len == 0 || !take(len)) return;
     const char* s = reinterpret_cast<const char*>(p_ + pos_ - len);
-    return std::string(s, strnlen(s, len));
+    out.assign(s, strnlen(s, len));
   }
 
  private:
@@ -143,7 +145,7 @@ void read(CdrIn& in, msg::MissionCommand& c) {
   in.get(c.value());
   in.get(c.leader_id());
   in.get(c.epsilon_m());
-  c.issuer() = in.string().c_str();  // fixed_string<64>: truncated as the generated code does
+  in.string(c.issuer());
   in.get(c.issuer_instance());
   in.get(c.server_instance());
   in.get(c.apply_tick());
