@@ -1,6 +1,7 @@
 #include "common/process.hpp"
 
 #include <pthread.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,6 +9,9 @@
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <exception>
 #include <mutex>
 #include <random>
@@ -161,6 +165,107 @@ bool wait_for_stop(std::chrono::duration<double> d) {
     g_cv.wait_for(lock, std::min(slice, end - now));
   }
   return g_stop.load();
+}
+
+namespace {
+struct DeadLockRestart {
+  std::string prog;
+  std::vector<std::string> args;
+  int max_restarts = 0;
+  std::terminate_handler previous = nullptr;
+  std::atomic<bool> entered{false};
+};
+DeadLockRestart& dead_lock_restart() {
+  static DeadLockRestart r;
+  return r;
+}
+
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);  // system-wide: it runs on across exec
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+// Execs this program again if the exception in flight is the dead owner's
+// lock timeout and the count allows; returns only when it did not.
+void try_dead_lock_restart(DeadLockRestart& r) {
+  const std::exception_ptr e = std::current_exception();
+  if (!e) return;
+  std::string what;
+  try {
+    std::rethrow_exception(e);
+  } catch (const std::exception& x) {
+    what = x.what();
+  } catch (...) {
+    return;
+  }
+  if (!is_dead_owner_lock_timeout(what.c_str())) return;
+  const std::int64_t now = monotonic_ns();
+  const int n = next_dead_lock_restart(std::getenv(kDeadLockRestartsEnv), now);
+  if (n > r.max_restarts) {
+    spdlog::error(
+        "{}: a Fast DDS thread met a shared-memory lock whose owner died ({}); {} restarts in "
+        "a row already, so not again",
+        r.prog, what, r.max_restarts);
+    spdlog::default_logger()->flush();
+    return;
+  }
+  spdlog::error(
+      "{}: a Fast DDS thread met a shared-memory lock whose owner died, a peer killed while "
+      "holding it ({}); starting this process again as a new participant, the same pid "
+      "({} of {} in a row)",
+      r.prog, what, n, r.max_restarts);
+  spdlog::default_logger()->flush();
+  std::fflush(nullptr);
+  const std::string count = std::to_string(n) + ":" + std::to_string(now);
+  setenv(kDeadLockRestartsEnv, count.c_str(), 1);
+  std::vector<char*> argv;
+  for (auto& a : r.args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  // Nothing of this process's but its standard streams goes on: the new
+  // participant makes its own ports, and the old ones' locks go with their
+  // descriptors, so the next clean-up sees them as left behind.
+  if (close_range(3, ~0U, 0) != 0)
+    for (long fd = 3, max = sysconf(_SC_OPEN_MAX); fd < max; ++fd) close(static_cast<int>(fd));
+  unblock_signals_for_exec();
+  execv("/proc/self/exe", argv.data());
+  std::fprintf(stderr, "%s: could not start again: %s\n", r.prog.c_str(), std::strerror(errno));
+}
+
+void on_terminate() {
+  auto& r = dead_lock_restart();
+  if (!r.entered.exchange(true)) try_dead_lock_restart(r);
+  (r.previous ? r.previous : std::abort)();
+}
+}  // namespace
+
+bool is_dead_owner_lock_timeout(const char* what) {
+  return what != nullptr && std::strstr(what, "owner died without unlocking") != nullptr;
+}
+
+int next_dead_lock_restart(const char* env_value, std::int64_t now_ns) {
+  int count = 0;
+  long long last_ns = 0;
+  if (env_value == nullptr || std::sscanf(env_value, "%d:%lld", &count, &last_ns) != 2 || count < 0)
+    return 1;
+  const double since_s = static_cast<double>(now_ns - last_ns) * 1e-9;
+  if (since_s < 0 || since_s > kDeadLockRestartWindowS) return 1;
+  return count + 1;
+}
+
+int dead_owner_lock_restarts() {
+  int count = 0;
+  const char* v = std::getenv(kDeadLockRestartsEnv);
+  if (v == nullptr || std::sscanf(v, "%d:", &count) != 1 || count < 0) return 0;
+  return count;
+}
+
+void restart_on_dead_owner_lock(const char* prog, int argc, char** argv, int max_restarts) {
+  auto& r = dead_lock_restart();
+  r.prog = prog;
+  r.args.assign(argv, argv + argc);
+  r.max_restarts = max_restarts;
+  r.previous = std::set_terminate(on_terminate);
 }
 
 int run_main(const char* prog, const std::function<int()>& body) {

@@ -84,6 +84,34 @@ class LeaseWatch {
   double lease_s_, last_s_;
 };
 
+/// Fast DDS 2.9 waits 1 s for an interprocess lock, then throws boost's
+/// "Interprocess mutex timeout when locking. Possible deadlock: owner died
+/// without unlocking?": a process was SIGKILLed while it held a lock in
+/// shared memory. Thrown on one of Fast DDS's own threads, nothing catches it
+/// and the process ends in std::terminate (an agent whose server was killed
+/// while notifying it, docs/faults.md). After this call such an end execs
+/// this program again instead: the same arguments, environment and PID, no
+/// file descriptor but 0-2, and a fresh DDS participant. At most max_restarts
+/// in a row (restarts more than kDeadLockRestartWindowS apart are not in a
+/// row); any other uncaught exception ends the process as before. For a
+/// process whose state its peers give back (an agent catches up with its
+/// mission from the server's samples), not for the server, whose world would
+/// start again. Call it in main, after install_stop_signals.
+void restart_on_dead_owner_lock(const char* prog, int argc, char** argv, int max_restarts = 3);
+/// How many times in a row restart_on_dead_owner_lock had started this
+/// process again when it began (0: its first start).
+int dead_owner_lock_restarts();
+/// Whether an exception's what() is Fast DDS's lock timeout on a dead owner.
+bool is_dead_owner_lock_timeout(const char* what);
+/// Restarts further apart than this (s) start the count again.
+constexpr double kDeadLockRestartWindowS = 60.0;
+/// The environment variable that carries the count across exec:
+/// "<restarts in a row>:<CLOCK_MONOTONIC ns of the last>".
+constexpr const char* kDeadLockRestartsEnv = "DDSWARM_DEAD_LOCK_RESTARTS";
+/// The pure rule: given the variable's value (nullptr when unset) and the
+/// monotonic clock now, the number this restart would be (1 = the first in a row).
+int next_dead_lock_restart(const char* env_value, std::int64_t now_ns);
+
 /// Runs body; maps ConfigError/CLI errors to exit 2, other exceptions to exit 1,
 /// printing "<prog>: error: <what>" on one line.
 int run_main(const char* prog, const std::function<int()>& body);

@@ -2,14 +2,19 @@
 
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <cstdlib>
 #include <mutex>
 #include <optional>
+#include <regex>
+#include <string>
 #include <thread>
+#include <vector>
 
 namespace ddswarm {
 namespace {
@@ -87,6 +92,79 @@ TEST(StopWaker, ASignalWakesALoopAsleepOnItsOwnCondition) {
 
 TEST(StopWaker, OnlyTheLivingAreWoken) {
   EXPECT_EXIT(only_living_wakers_called(), ::testing::ExitedWithCode(0), "");
+}
+
+// dead_lock_probe (dead_lock_probe.cpp) run to its end: what it printed, and
+// its wait status.
+struct ProbeRun {
+  std::string out;
+  int status = 0;
+};
+ProbeRun run_probe(const std::string& mode, int max_restarts) {
+  const std::string cmd = std::string("exec ") + DDSWARM_DEAD_LOCK_PROBE + " " + mode + " " +
+                          std::to_string(max_restarts) + " 2>&1";
+  ProbeRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) r.out += buf;
+  r.status = pclose(p);
+  return r;
+}
+
+// The pids and open descriptors of each "run N pid P fds F" line, by N.
+struct Runs {
+  std::vector<int> pids, fds;
+};
+Runs runs_of(const std::string& out) {
+  Runs r;
+  const std::regex line(R"(run (\d+) pid (\d+) fds (\d+))");
+  for (std::sregex_iterator it(out.begin(), out.end(), line), end; it != end; ++it) {
+    if (std::stoi((*it)[1]) != static_cast<int>(r.pids.size())) break;
+    r.pids.push_back(std::stoi((*it)[2]));
+    r.fds.push_back(std::stoi((*it)[3]));
+  }
+  return r;
+}
+
+TEST(DeadLockRestart, AFastDdsThreadThatMeetsADeadOwnersLockStartsTheProcessAgain) {
+  const ProbeRun r = run_probe("lock-once", 3);
+  ASSERT_TRUE(WIFEXITED(r.status) && WEXITSTATUS(r.status) == 0) << r.out;
+  const Runs runs = runs_of(r.out);
+  ASSERT_EQ(runs.pids.size(), 2u) << r.out;
+  EXPECT_EQ(runs.pids[0], runs.pids[1]) << "the same process, the same pid: " << r.out;
+  EXPECT_EQ(runs.fds[1], 0) << "no descriptor but 0-2 goes on: " << r.out;
+  EXPECT_NE(r.out.find("owner died"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 of 3 in a row"), std::string::npos) << r.out;
+}
+
+TEST(DeadLockRestart, StopsStartingAgainAfterItsRestartsInARow) {
+  const ProbeRun r = run_probe("lock-always", 2);
+  EXPECT_TRUE(WIFSIGNALED(r.status) && WTERMSIG(r.status) == SIGABRT) << r.out;
+  EXPECT_EQ(runs_of(r.out).pids.size(), 3u) << "the first run and 2 restarts: " << r.out;
+  EXPECT_NE(r.out.find("so not again"), std::string::npos) << r.out;
+}
+
+TEST(DeadLockRestart, AnyOtherUncaughtExceptionEndsTheProcessAsBefore) {
+  const ProbeRun r = run_probe("other", 3);
+  EXPECT_TRUE(WIFSIGNALED(r.status) && WTERMSIG(r.status) == SIGABRT) << r.out;
+  EXPECT_EQ(runs_of(r.out).pids.size(), 1u) << r.out;
+  EXPECT_NE(r.out.find("an unrelated failure"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("starting this process again"), std::string::npos) << r.out;
+}
+
+TEST(DeadLockRestart, CountsRestartsInARowWithinItsWindow) {
+  const std::int64_t s = 1000000000;
+  EXPECT_EQ(next_dead_lock_restart(nullptr, 100 * s), 1);
+  EXPECT_EQ(next_dead_lock_restart("1:100000000000", 130 * s), 2);
+  EXPECT_EQ(next_dead_lock_restart("2:100000000000", 159 * s), 3);
+  EXPECT_EQ(next_dead_lock_restart("2:100000000000", 161 * s), 1) << "long ago: not in a row";
+  EXPECT_EQ(next_dead_lock_restart("garbage", 100 * s), 1);
+  EXPECT_EQ(next_dead_lock_restart("1:200000000000", 100 * s), 1) << "from the future";
+  EXPECT_TRUE(is_dead_owner_lock_timeout(
+      "Interprocess mutex timeout when locking. Possible deadlock: owner died without unlocking?"));
+  EXPECT_FALSE(is_dead_owner_lock_timeout("Interprocess mutex timeout when locking"));
+  EXPECT_FALSE(is_dead_owner_lock_timeout(nullptr));
 }
 
 }  // namespace
