@@ -77,6 +77,13 @@ int main(int argc, char** argv) {
     spdlog::set_pattern("[%H:%M:%S.%e] [%l] %v");
     ddswarm::install_stop_signals();
     ddswarm::install_rejoin_signal();
+    // A killed server's lock met on a Fast DDS thread would end this agent
+    // (docs/faults.md); it starts again instead and catches up with its mission.
+    ddswarm::restart_on_dead_owner_lock("ddswarm-agent", argc, argv);
+    if (const int n = ddswarm::dead_owner_lock_restarts(); n > 0)
+      spdlog::warn("ddswarm-agent: started again after a dead peer's shared-memory lock ({} in a "
+                   "row); joining DDS as a new participant and catching up with the mission",
+                   n);
     try {
       using ddswarm::agent::AgentApp;
       // A new participant each time no scene came (agent.rejoin_after_s), SIGUSR1 asked for one,

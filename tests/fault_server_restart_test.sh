@@ -20,14 +20,17 @@ kill -KILL "$PID_sim1"; wait "$PID_sim1" 2>/dev/null
 killed=$(date +%s.%N)
 # Noticed within about a second (agents' server_timeout_s and the ground
 # station's status watch are 1 s; allow scheduling slack on a loaded machine).
+# An agent may instead meet a lock the killed server held, on a Fast DDS
+# thread, and start again as a new participant (docs/faults.md): it says so.
+lost='no server samples|a shared-memory lock whose owner died'
 for _ in $(seq 40); do
-  grep -q "server lost" "$WORK/gstask.log" && [ "$(grep -l "no server samples" "$WORK"/agent_*.log | wc -l)" -eq 6 ] && break
+  grep -q "server lost" "$WORK/gstask.log" && [ "$(grep -lE "$lost" "$WORK"/agent_*.log | wc -l)" -eq 6 ] && break
   sleep 0.1
 done
 noticed=$(date +%s.%N)
 echo "noticed $(echo "$noticed - $killed" | bc) s after the kill"
 grep -q "server lost" "$WORK/gstask.log" || fail "the ground station did not report the lost server"
-[ "$(grep -l "no server samples" "$WORK"/agent_*.log | wc -l)" -eq 6 ] || fail "not every agent reported the lost server"
+[ "$(grep -lE "$lost" "$WORK"/agent_*.log | wc -l)" -eq 6 ] || fail "not every agent reported the lost server"
 awk -v a="$killed" -v b="$noticed" 'BEGIN { exit !(b - a < 2.5) }' || fail "noticed too late"
 kill -0 "$PID_gstask" 2>/dev/null || fail "the ground station gave up while the server was away"
 start sim2 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
@@ -35,9 +38,11 @@ wait_pid "$PID_gstask" 30; rc=$?
 cat "$WORK/gstask.log"
 [ $rc -eq 1 ] || fail "the waiting ground station should end the task with exit 1, got $rc"
 grep -q "task failed: server restarted" "$WORK/gstask.log" || fail "the reason is not named"
+# An agent started again has no old mission to reset.
+reset='mission reset|started again after a dead peer'
 for i in 0 1 2 3 4 5; do
-  for _ in $(seq 50); do grep -q "mission reset" "$WORK/agent_$i.log" && break; sleep 0.1; done
-  grep -q "mission reset" "$WORK/agent_$i.log" || fail "agent $i did not reset its mission for the new server"
+  for _ in $(seq 50); do grep -qE "$reset" "$WORK/agent_$i.log" && break; sleep 0.1; done
+  grep -qE "$reset" "$WORK/agent_$i.log" || fail "agent $i did not reset its mission for the new server"
 done
 sleep 1
 grep -q "released" "$WORK/sim2.log" && fail "the new server replayed an old mission command"

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# The server is SIGKILLed at the worst moment: while its swarm-state write
+# holds the lock of an agent's data-sharing notification, in that agent's
+# shared memory (gdb stops it there; docs/faults.md). Nothing ever releases
+# that lock, and Fast DDS 2.9 throws when it has waited 1 s for it, on its
+# own threads as well, which ended the agent in std::terminate (and, with the
+# launcher's default policy, the whole swarm). Every agent must live through
+# it, as the same process, and fly again with a new server.
+source "$(dirname "$0")/lib.sh"
+command -v gdb >/dev/null || fail "gdb is missing (scripts/setup installs it)"
+scenario="$SRC/config/thesis_course.yaml"
+gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
+start sim1 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
+start agents "$BIN/ddswarm-launch" "$scenario" --only agents --domain "$DOMAIN" --log-dir "$WORK"
+gs wait-agents --count 6 --timeout 60 || fail "agents not online"
+gs takeoff --wait || fail "takeoff"
+agent_pids=$(pgrep -f -- "ddswarm-agent .*--domain $DOMAIN\b" | sort)
+[ "$(echo "$agent_pids" | wc -w)" -eq 6 ] || fail "not 6 agent processes: $agent_pids"
+
+# The agents' notification segments as the server maps them: readers' (an
+# entity id ending in .4) whose participant is not the server's own, that of
+# its writer pools (ending in .3).
+maps=$(awk '$6 ~ /\/fast_datasharing_/ { print $1, $6 }' "/proc/$PID_sim1/maps" | sort -u -k2,2)
+own=$(echo "$maps" | awk '$2 ~ /\.3$/ { n = $2; sub(/.*fast_datasharing_/, "", n); sub(/_.*/, "", n); print n; exit }')
+target=$(echo "$maps" | awk -v own="$own" '$2 ~ /\.4$/ && index($2, own) == 0 { print; exit }')
+[ -n "$own" ] && [ -n "$target" ] || { echo "$maps"; fail "no agent's notification segment in the server's maps"; }
+range=${target%% *}
+echo "the lock to die holding: ${target#* } at $range"
+timeout 60 gdb -p "$PID_sim1" -batch -ex "set pagination off" \
+  -ex "break pthread_mutex_unlock if \$rdi >= 0x${range%-*} && \$rdi < 0x${range#*-}" \
+  -ex continue -ex "bt 4" -ex "shell kill -KILL $PID_sim1" >"$WORK/gdb.log" 2>&1
+wait "$PID_sim1" 2>/dev/null
+kill -0 "$PID_sim1" 2>/dev/null && fail "the server is still running"
+grep -q "deliver_sample_to_datasharing" "$WORK/gdb.log" ||
+  { cat "$WORK/gdb.log"; fail "the server was not stopped in a swarm-state write holding the lock"; }
+echo "server killed holding the lock"
+
+# Longer than twice the lease (dds.lease_duration_s 3 s): every agent has
+# found the server gone and joined again as a new participant, so that one
+# whose own port the server may have held also hears the next server.
+sleep 7
+gone=$(grep -lE "the server has been gone|owner died" "$WORK"/agent_*.log | wc -l)
+[ "$gone" -eq 6 ] || fail "$gone of 6 agents said that the server was gone"
+start sim2 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
+gs wait-agents --count 6 --timeout 60 || fail "the agents did not come back with the new server"
+kill -0 "$PID_agents" 2>/dev/null || fail "the launcher stopped the swarm: an agent died"
+[ "$(pgrep -f -- "ddswarm-agent .*--domain $DOMAIN\b" | sort)" = "$agent_pids" ] ||
+  fail "the agent processes are not the same ones"
+grep -h "owner died\|joining again" "$WORK"/agent_*.log || true
+gs takeoff --wait || fail "takeoff with the new server"
+gs status | tee "$WORK/status.txt"
+grep -q "6 airborne" "$WORK/status.txt" || fail "the swarm did not take off with the new server"
+echo PASS
