@@ -650,22 +650,6 @@ struct AgentApp::Impl {
             return AgentApp::End::kDeaf;
           }
         }
-        // Deaf to any new server: the old one has been gone for twice the
-        // lease (no swarm state, none of its scene writers matched). A server
-        // SIGKILLed while it held the lock of this participant's shared-memory
-        // port leaves every later message to that port lost after a 1 s wait,
-        // a new server's discovery included (docs/faults.md); a new
-        // participant has a port of its own. Once per participant that heard
-        // a scene: the next waits for one as any new participant does.
-        if (scene && server_lost && scenes->matched() == 0) {
-          const double gone = wall_seconds() - last_sample_wall;
-          if (gone > 2 * cfg.dds.lease_duration_s) {
-            spdlog::warn("{}: the server has been gone for {:.1f} s; leaving DDS and joining again "
-                         "as a new participant, to hear the next one",
-                         label, gone);
-            return AgentApp::End::kServerGone;
-          }
-        }
         // Fast DDS 2.9 sometimes never matches one of 128 participants that
         // start at once (docs/performance.md); a new participant is
         // discovered afresh. No scene also means no mission to lose.

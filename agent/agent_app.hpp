@@ -42,15 +42,7 @@ class AgentApp {
   /// Joins DDS and checks that no other agent flies this drone (throws DuplicateAgent).
   explicit AgentApp(AgentAppConfig cfg);
   ~AgentApp();
-  enum class End {
-    kStopped,
-    kNoScene,
-    kRejoinRequested,
-    kOutlivedLease,
-    kUnheard,
-    kDeaf,
-    kServerGone
-  };
+  enum class End { kStopped, kNoScene, kRejoinRequested, kOutlivedLease, kUnheard, kDeaf };
   /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
   /// kStopped. kNoScene when no scene came within agent.rejoin_after_s of
   /// joining, kRejoinRequested on take_rejoin_request() (SIGUSR1),
@@ -58,9 +50,7 @@ class AgentApp {
   /// its DDS lease (dds.lease_duration_s), so its peers may have dropped it,
   /// kUnheard when the server's samples have said for twice that lease that
   /// it hears none of this process's answers, kDeaf when no swarm state came
-  /// for twice that lease while the server's scene writer stayed matched,
-  /// kServerGone when the server whose scene it heard has been silent and
-  /// unmatched for twice that lease:
+  /// for twice that lease while the server's scene writer stayed matched:
   /// the caller should destroy this app and join again.
   End run(double duration_s);
   /// Whether this participant has heard the server's scene.
