@@ -232,9 +232,20 @@ void try_dead_lock_restart(DeadLockRestart& r) {
   std::fprintf(stderr, "%s: could not start again: %s\n", r.prog.c_str(), std::strerror(errno));
 }
 
+thread_local bool t_in_terminate = false;
+
 void on_terminate() {
   auto& r = dead_lock_restart();
-  if (!r.entered.exchange(true)) try_dead_lock_restart(r);
+  if (t_in_terminate) std::abort();  // this handler itself failed
+  t_in_terminate = true;
+  // Two Fast DDS threads may meet the dead lock at once: the first one here
+  // ends or restarts the process, and the others must not abort it meanwhile.
+  // Bounded, so that nothing hangs if the first one does.
+  if (r.entered.exchange(true)) {
+    std::this_thread::sleep_for(std::chrono::seconds(10));
+    std::abort();
+  }
+  try_dead_lock_restart(r);
   (r.previous ? r.previous : std::abort)();
 }
 }  // namespace
