@@ -8,12 +8,7 @@
 # it, as the same process, and fly again with a new server.
 source "$(dirname "$0")/lib.sh"
 command -v gdb >/dev/null || fail "gdb is missing (scripts/setup installs it)"
-scenario="$SRC/config/thesis_course.yaml"
-gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
-start sim1 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
-start agents "$BIN/ddswarm-launch" "$scenario" --only agents --domain "$DOMAIN" --log-dir "$WORK"
-gs wait-agents --count 6 --timeout 60 || fail "agents not online"
-gs takeoff --wait || fail "takeoff"
+fly_six_own_server
 agent_pids=$(pgrep -f -- "ddswarm-agent .*--domain $DOMAIN\b" | sort)
 [ "$(echo "$agent_pids" | wc -w)" -eq 6 ] || fail "not 6 agent processes: $agent_pids"
 

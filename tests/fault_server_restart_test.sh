@@ -6,12 +6,7 @@
 # named), the old ground station's mission history is not replayed into the
 # new world, and the swarm can be flown again. Nothing hangs.
 source "$(dirname "$0")/lib.sh"
-scenario="$SRC/config/thesis_course.yaml"
-gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
-start sim1 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
-start agents "$BIN/ddswarm-launch" "$scenario" --only agents --domain "$DOMAIN" --log-dir "$WORK"
-gs wait-agents --count 6 --timeout 60 || fail "agents not online"
-gs takeoff --wait || fail "takeoff"
+fly_six_own_server
 start gstask "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" task
 for _ in $(seq 100); do grep -q "acknowledged" "$WORK/gstask.log" && break; sleep 0.1; done
 grep -q "task 6/6 acknowledged" "$WORK/gstask.log" || fail "task not accepted"

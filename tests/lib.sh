@@ -77,6 +77,18 @@ fly_six_realtime() {
 }
 gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
 
+# fly_six_own_server: the thesis scenario in real time, its server started by
+# the test itself (sim1, for the test to kill and replace), its six agents by
+# ddswarm-launch --only agents (logs in $WORK); every agent online and the
+# swarm airborne.
+fly_six_own_server() {
+  scenario="$SRC/config/thesis_course.yaml"
+  start sim1 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
+  start agents "$BIN/ddswarm-launch" "$scenario" --only agents --domain "$DOMAIN" --log-dir "$WORK"
+  gs wait-agents --count 6 --timeout 60 || fail "agents not online"
+  gs takeoff --wait || fail "takeoff"
+}
+
 # probe_swarm N: 5 s of swarm_probe --ages on a flying swarm of N, printed;
 # probe_val KEY then prints one of its figures (rtf, age_p99_periods, ...).
 probe_swarm() {
