@@ -166,6 +166,9 @@ struct AgentApp::Impl {
   double last_sample_wall = -1e9;
   double scene_wall = -1e9;  // when the server's scene came (wall)
   bool server_lost = false;
+  // A lost server: the swarm-state reader is made anew (sync_states_reader),
+  // as docs/faults.md says. mu held.
+  bool renew_states = false;
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
   std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
   bool loss_logged = false;    // agent.state_loss said so in the log
@@ -257,11 +260,19 @@ struct AgentApp::Impl {
   /// removing a reader waits for its running callback, which takes mu.
   void sync_states_reader() {
     std::optional<Delivery> want;
+    bool renew = false;
     {
       std::lock_guard<std::mutex> lock(mu);
       want = states_wanted;
+      renew = std::exchange(renew_states, false) && states != nullptr;
     }
-    if (!want || (states && *want == states_delivery)) return;
+    if (!want || (states && *want == states_delivery && !renew)) return;
+    // Renewed when the server is lost: a server SIGKILLed while it notified
+    // this reader left its lock held, and every later writer would wait 1 s
+    // on it per sample, a new server included. Deleting the reader takes that
+    // lock too: Fast DDS throws on its thread, and this agent starts again
+    // (restart_on_dead_owner_lock) before a new server can come. A sound
+    // reader is made anew in a moment.
     if (states) dds.remove(*states);
     states = &dds.reader<msg::SwarmState>(
         [this](const msg::SwarmState& s, const fdds::SampleInfo& info) {
@@ -610,6 +621,7 @@ struct AgentApp::Impl {
         double silent = wall_seconds() - last_sample_wall;
         if (have_tick && !server_lost && silent > cfg.agent.server_timeout_s) {
           server_lost = true;
+          renew_states = true;
           for (auto& b : brains) b->unheard_since = -1;  // counted again once it speaks
           spdlog::warn("{}: no server samples for {:.1f} s; holding commands until it returns",
                        label, silent);

@@ -8,7 +8,12 @@
 # it, as the same process, and fly again with a new server.
 source "$(dirname "$0")/lib.sh"
 command -v gdb >/dev/null || fail "gdb is missing (scripts/setup installs it)"
-fly_six_own_server
+# gdb stops the server for a second or more each time it attaches. An agent
+# that counted that as a lost server would make its swarm-state reader anew
+# (docs/faults.md) while the server stood stopped, and the lock the server
+# then died holding would be a deleted reader's: with a 4 s timeout the
+# agents keep their readers until after the kill.
+fly_six_own_server --set agent.server_timeout_s=4
 agent_pids=$(pgrep -f -- "ddswarm-agent .*--domain $DOMAIN\b" | sort)
 [ "$(echo "$agent_pids" | wc -w)" -eq 6 ] || fail "not 6 agent processes: $agent_pids"
 
@@ -46,6 +51,10 @@ grep -m2 "^#[01] " "$WORK/gdb.log" | cut -c1-160
 
 sleep 2
 start sim2 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
+# The agent whose lock it was meets it on a Fast DDS thread as it matches the
+# new server, and starts again.
+for _ in $(seq 150); do grep -q "starting this process again" "$WORK"/agent_*.log && break; sleep 0.1; done
+grep -q "starting this process again" "$WORK"/agent_*.log || fail "no agent met the dead lock in 15 s"
 gs wait-agents --count 6 --timeout 60 || fail "the agents did not come back with the new server"
 kill -0 "$PID_agents" 2>/dev/null || fail "the launcher stopped the swarm: an agent died"
 [ "$(pgrep -f -- "ddswarm-agent .*--domain $DOMAIN\b" | sort)" = "$agent_pids" ] ||

@@ -77,14 +77,14 @@ fly_six_realtime() {
 }
 gs() { timeout 60 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" "$@"; }
 
-# fly_six_own_server: the thesis scenario in real time, its server started by
-# the test itself (sim1, for the test to kill and replace), its six agents by
-# ddswarm-launch --only agents (logs in $WORK); every agent online and the
-# swarm airborne.
+# fly_six_own_server [ARGS...]: the thesis scenario in real time, its server
+# started by the test itself (sim1, for the test to kill and replace), its six
+# agents by ddswarm-launch --only agents ARGS (logs in $WORK); every agent
+# online and the swarm airborne.
 fly_six_own_server() {
   scenario="$SRC/config/thesis_course.yaml"
   start sim1 "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"
-  start agents "$BIN/ddswarm-launch" "$scenario" --only agents --domain "$DOMAIN" --log-dir "$WORK"
+  start agents "$BIN/ddswarm-launch" "$scenario" --only agents --domain "$DOMAIN" "$@" --log-dir "$WORK"
   gs wait-agents --count 6 --timeout 60 || fail "agents not online"
   gs takeoff --wait || fail "takeoff"
 }
