@@ -7,6 +7,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <deque>
+#include <exception>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -270,10 +271,17 @@ struct AgentApp::Impl {
     // Renewed when the server is lost: a server SIGKILLed while it notified
     // this reader left its lock held, and every later writer would wait 1 s
     // on it per sample, a new server included. Deleting the reader takes that
-    // lock too: Fast DDS throws on its thread, and this agent starts again
-    // (restart_on_dead_owner_lock) before a new server can come. A sound
-    // reader is made anew in a moment.
-    if (states) dds.remove(*states);
+    // lock as well: where Fast DDS throws, this agent starts again
+    // (restart_on_dead_owner_lock) before a new server can come, here as on
+    // Fast DDS's own threads. A sound reader is made anew in a moment.
+    if (states) {
+      try {
+        dds.remove(*states);
+      } catch (const std::exception& e) {
+        if (is_dead_owner_lock_timeout(e.what())) std::terminate();
+        throw;
+      }
+    }
     states = &dds.reader<msg::SwarmState>(
         [this](const msg::SwarmState& s, const fdds::SampleInfo& info) {
           on_swarm(s, info.sample_identity.writer_guid().guidPrefix);
