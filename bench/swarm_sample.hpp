@@ -5,6 +5,7 @@
 #include <random>
 
 #include "SwarmState.h"
+#include "common/convert.hpp"
 
 namespace ddswarm {
 
@@ -17,19 +18,10 @@ inline msg::SwarmState bench_swarm(int n, int rays) {
   for (int i = 0; i < n; ++i) {
     msg::DroneState d;
     d.drone_id(i);
-    msg::Vec3 p;
-    p.x(u(rng));
-    p.y(u(rng));
-    p.z(2 + u(rng) / 50);
-    d.position(p);
-    msg::Quat q;
-    q.w(0.99875);
-    q.x(0.0499792);
-    d.orientation(q);
-    msg::Vec3 v;
-    v.x(0.8123);
-    v.y(-0.0421);
-    d.velocity(v);
+    const double x = u(rng), y = u(rng), z = 2 + u(rng) / 50;  // in this order
+    d.position(to_msg(Eigen::Vector3d(x, y, z)));
+    d.orientation(to_msg(Eigen::Quaterniond(0.99875, 0.0499792, 0, 0)));
+    d.velocity(to_msg(Eigen::Vector3d(0.8123, -0.0421, 0)));
     d.motor_speed_rad_s({612.3f, 611.9f, 613.0f, 612.7f});
     d.flags(1 | 4 | 32);
     d.phase(4);
