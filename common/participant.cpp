@@ -3,6 +3,7 @@
 #include "common/shm_clean.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/log/Log.hpp>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
@@ -11,6 +12,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -250,6 +252,52 @@ eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrt
   return p;
 }
 
+/// Under DDS Security, what this participant knows of each remote one, by
+/// GUID: its name, when it announced itself and when it authenticated.
+/// Fed by Fast DDS's threads; the announcement comes before the handshake.
+class AuthenticationWatch : public fdds::DomainParticipantListener {
+ public:
+  using ParticipantDiscoveryInfo = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+  using ParticipantAuthenticationInfo = eprosima::fastrtps::rtps::ParticipantAuthenticationInfo;
+
+  void on_participant_discovery(fdds::DomainParticipant*,
+                                ParticipantDiscoveryInfo&& info) override {
+    const std::lock_guard<std::mutex> lock(mu_);
+    const auto& guid = info.info.m_guid;
+    if (info.status == ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT)
+      peers_.try_emplace(guid, Peer{info.info.m_participantName.to_string(), wall_seconds(), -1.0});
+    else if (info.status == ParticipantDiscoveryInfo::REMOVED_PARTICIPANT ||
+             info.status == ParticipantDiscoveryInfo::DROPPED_PARTICIPANT)
+      peers_.erase(guid);
+  }
+  void onParticipantAuthentication(fdds::DomainParticipant*,
+                                   ParticipantAuthenticationInfo&& info) override {
+    const std::lock_guard<std::mutex> lock(mu_);
+    auto it = peers_.find(info.guid);
+    if (it != peers_.end() && info.status == ParticipantAuthenticationInfo::AUTHORIZED_PARTICIPANT)
+      it->second.authenticated_after_s = wall_seconds() - it->second.since;
+  }
+
+  std::optional<SecurePeer> oldest(const std::string& name) const {
+    const std::lock_guard<std::mutex> lock(mu_);
+    std::optional<SecurePeer> found;
+    const double now = wall_seconds();
+    for (const auto& [guid, p] : peers_)
+      if (p.name == name && (!found || now - p.since > found->announced_s))
+        found = SecurePeer{now - p.since, p.authenticated_after_s};
+    return found;
+  }
+
+ private:
+  struct Peer {
+    std::string name;
+    double since;
+    double authenticated_after_s;
+  };
+  mutable std::mutex mu_;
+  std::map<eprosima::fastrtps::rtps::GUID_t, Peer> peers_;
+};
+
 Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   cfg.validate();
   apply_fastdds_log_env();
@@ -278,10 +326,15 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     if (clear_id)
       qos.wire_protocol().participant_id = participant_id_clear_of_shm(
           cfg.domain_id, std::min(kInitialPeersRange - 1, max_participant_id(cfg.domain_id)));
-    participant_ = factory->create_participant(cfg.domain_id, qos);
+    // The watch hears discovery and authentication only (no data status):
+    // every reader and writer keeps its own listener.
+    if (secure_) auth_watch_ = std::make_unique<AuthenticationWatch>();
+    participant_ = factory->create_participant(cfg.domain_id, qos, auth_watch_.get(),
+                                               fdds::StatusMask::none());
     if (!participant_ && clear_id && qos.wire_protocol().participant_id >= 0) {
       qos.wire_protocol().participant_id = -1;  // e.g. the id is this process's already: Fast DDS picks
-      participant_ = factory->create_participant(cfg.domain_id, qos);
+      participant_ = factory->create_participant(cfg.domain_id, qos, auth_watch_.get(),
+                                                 fdds::StatusMask::none());
     }
     if (participant_) {
       if (!pp.first) pp.first = participant_->guid().guidPrefix;
@@ -295,7 +348,16 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
                             : std::string()));
   publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
-  if (!publisher_ || !subscriber_) throw DdsError("cannot create DDS publisher/subscriber");
+  if (!publisher_ || !subscriber_) {
+    participant_->delete_contained_entities();  // before its listener goes
+    fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+    participant_ = nullptr;
+    throw DdsError("cannot create DDS publisher/subscriber");
+  }
+}
+
+std::optional<SecurePeer> Participant::secure_peer(const std::string& name) const {
+  return auth_watch_ ? auth_watch_->oldest(name) : std::nullopt;
 }
 
 fdds::Publisher* Participant::publisher_for(const std::string& partition) {

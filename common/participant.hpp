@@ -157,6 +157,16 @@ class Reader : public fdds::DataReaderListener {
 eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
                                                           std::uint32_t n);
 
+class AuthenticationWatch;
+
+/// A remote participant as seen under DDS Security (Participant::secure_peer).
+struct SecurePeer {
+  double announced_s;  ///< since it announced itself (its discovery data came)
+  /// How long after its announcement its authentication handshake with this
+  /// participant passed; < 0 while it has not (pending, or refused).
+  double authenticated_after_s;
+};
+
 class Participant {
  public:
   /// Joins the domain; throws DdsError naming what failed. name shows in tools.
@@ -246,6 +256,10 @@ class Participant {
   fdds::DomainParticipant* raw() const { return participant_; }
   /// True when DDS Security is on (DdsConfig::security_dir).
   bool secure() const { return secure_; }
+  /// Under DDS Security: of the live remote participants named `name`, the one
+  /// that announced itself longest ago; none without DDS Security. Fast DDS
+  /// 2.9 sometimes leaves a handshake pending for good (docs/security.md).
+  std::optional<SecurePeer> secure_peer(const std::string& name) const;
   /// True when this participant uses shared memory (the transport and
   /// data-sharing delivery): dds.shared_memory, and neither DDS Security nor
   /// the TSan build.
@@ -275,6 +289,7 @@ class Participant {
     return t;
   }
 
+  std::unique_ptr<AuthenticationWatch> auth_watch_;  // under DDS Security; outlives participant_
   fdds::DomainParticipant* participant_ = nullptr;
   bool closed_ = false;
   bool secure_ = false;

@@ -85,6 +85,10 @@ inline constexpr bool kPerDronePartition = false;
 template <>
 inline constexpr bool kPerDronePartition<msg::VelocityCommand> = true;
 
+/// The participant name the simulation server joins DDS under (it shows in
+/// tools; agents look for it under DDS Security: Participant::secure_peer).
+inline constexpr const char* kServerParticipantName = "ddswarm-sim";
+
 /// The per-tick streams, state out and commands back: a newer sample
 /// supersedes a lost one, so in real time the swarm's own readers may read
 /// them best-effort (dds.best_effort_streams, Delivery::kLatest).

@@ -188,7 +188,7 @@ struct SimServer::Impl {
         starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
         world(cfg.scene, cfg.quadrotor, starts, cfg.scene.start.yaw_rad),
         referee(cfg.scene),
-        dds(cfg.dds, "ddswarm-sim"),
+        dds(cfg.dds, kServerParticipantName),
         w_swarm(dds.writer<msg::SwarmState>()),
         w_drone(dds.writer<msg::DroneState>()),
         w_scan(dds.writer<msg::DistanceScan>()),
