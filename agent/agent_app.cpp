@@ -341,7 +341,15 @@ struct AgentApp::Impl {
     scene_seed = s.seed();
     scene = scene_from_msg(s);
     for (const auto& b : brains) start_brain(*b);
-    spdlog::info("{}: scene '{}' received", label, s.name().to_string());
+    // Under DDS Security, how long the server took (docs/security.md).
+    if (const auto server = dds.secure_peer(kServerParticipantName);
+        server && server->authenticated_after_s >= 0)
+      spdlog::info(
+          "{}: scene '{}' received, {:.1f} s after the server announced itself (it "
+          "authenticated this participant after {:.1f} s)",
+          label, s.name().to_string(), server->announced_s, server->authenticated_after_s);
+    else
+      spdlog::info("{}: scene '{}' received", label, s.name().to_string());
     const double reach = sensor_range_m(cfg.agent.sensor_function);
     if (reach > s.sensor_max_range_m() + 1e-6)
       spdlog::warn("{}: agent.sensor_function reacts up to {:.1f} m but the sensors "
@@ -593,10 +601,12 @@ struct AgentApp::Impl {
 
   AgentApp::End run(double duration_s) {
     const double joined = wall_seconds();
-    // Spread by process up to longest_scene_wait_s (AgentConfig::kRejoinSpread).
-    const double patience = cfg.agent.rejoin_after_s *
-                            (1.0 + AgentConfig::kRejoinSpread *
-                                       static_cast<double>(brains[0]->instance % 1024) / 1024.0);
+    // Both waits spread by process, up to AgentConfig::kRejoinSpread longer,
+    // so that agents that missed the server do not all join again at once.
+    const double spread =
+        1.0 + AgentConfig::kRejoinSpread * static_cast<double>(brains[0]->instance % 1024) / 1024.0;
+    const double patience = cfg.agent.rejoin_after_s * spread;
+    const double secure_patience = cfg.agent.handshake_timeout_s * spread;
     double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
@@ -668,6 +678,23 @@ struct AgentApp::Impl {
                 "joining again as a new participant",
                 label, deaf);
             return AgentApp::End::kDeaf;
+          }
+        }
+        // Under DDS Security a server that announced itself authenticates
+        // this participant within a second or two, at 16 drones too; its
+        // scene may take longer (rejoin_after_s waits for that). Fast DDS 2.9
+        // sometimes leaves a handshake pending for good (docs/security.md):
+        // a new participant starts every handshake afresh.
+        if (!scene && cfg.agent.handshake_timeout_s > 0) {
+          const auto server = dds.secure_peer(kServerParticipantName);
+          if (server && server->authenticated_after_s < 0 &&
+              server->announced_s > secure_patience) {
+            spdlog::warn(
+                "{}: the server announced itself {:.1f} s ago and its authentication "
+                "handshake with this participant has not ended; leaving DDS and joining "
+                "again as a new participant",
+                label, server->announced_s);
+            return AgentApp::End::kSecureStall;
           }
         }
         // Fast DDS 2.9 sometimes never matches one of 128 participants that

@@ -42,7 +42,15 @@ class AgentApp {
   /// Joins DDS and checks that no other agent flies this drone (throws DuplicateAgent).
   explicit AgentApp(AgentAppConfig cfg);
   ~AgentApp();
-  enum class End { kStopped, kNoScene, kRejoinRequested, kOutlivedLease, kUnheard, kDeaf };
+  enum class End {
+    kStopped,
+    kNoScene,
+    kRejoinRequested,
+    kOutlivedLease,
+    kUnheard,
+    kDeaf,
+    kSecureStall
+  };
   /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
   /// kStopped. kNoScene when no scene came within agent.rejoin_after_s of
   /// joining, kRejoinRequested on take_rejoin_request() (SIGUSR1),
@@ -50,7 +58,10 @@ class AgentApp {
   /// its DDS lease (dds.lease_duration_s), so its peers may have dropped it,
   /// kUnheard when the server's samples have said for twice that lease that
   /// it hears none of this process's answers, kDeaf when no swarm state came
-  /// for twice that lease while the server's scene writer stayed matched:
+  /// for twice that lease while the server's scene writer stayed matched,
+  /// kSecureStall when, under DDS Security, the server announced itself
+  /// agent.handshake_timeout_s ago, no scene came and its authentication
+  /// handshake with this participant has not ended:
   /// the caller should destroy this app and join again.
   End run(double duration_s);
   /// Whether this participant has heard the server's scene.

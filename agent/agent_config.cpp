@@ -127,6 +127,8 @@ void AgentConfig::validate() const {
   check_positive("agent.teleop_timeout_s", teleop_timeout_s);
   check_positive("agent.server_timeout_s", server_timeout_s);
   if (rejoin_after_s != 0) check_range("agent.rejoin_after_s", rejoin_after_s, 2.0, 3600.0);
+  if (handshake_timeout_s != 0)
+    check_range("agent.handshake_timeout_s", handshake_timeout_s, 2.0, 3600.0);
   check_range("agent.state_loss", state_loss, 0.0, 0.5);
 }
 
@@ -173,6 +175,7 @@ void load(YamlSection s, AgentConfig& c) {
   s.get("teleop_timeout_s", c.teleop_timeout_s);
   s.get("server_timeout_s", c.server_timeout_s);
   s.get("rejoin_after_s", c.rejoin_after_s);
+  s.get("handshake_timeout_s", c.handshake_timeout_s);
   s.get("state_loss", c.state_loss);
   s.finish();
 }

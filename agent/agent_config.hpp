@@ -77,6 +77,13 @@ struct AgentConfig {
   double server_timeout_s = 1.0;   ///< s (wall): no server sample this long = server lost (logged once, flagged in heartbeats); > 0
   double rejoin_after_s = 40.0;  ///< s (wall): no scene this long after joining: leave DDS and join
                                  ///< again as a new participant (0 = never)
+  /// s (wall), under DDS Security: the server announced itself this long ago
+  /// and its authentication handshake with this agent has not ended (Fast
+  /// DDS 2.9 sometimes leaves one so for good): the agent joins again as a
+  /// new participant (0 = never). Up to 1.5 times as long,
+  /// spread by process (kRejoinSpread); twice as long after each such join
+  /// in a row, at most 8 times.
+  double handshake_timeout_s = 10.0;
   /// A join waits rejoin_after_s for the scene, and up to this share longer,
   /// different in every process: when a whole swarm missed the server, its
   /// agents must not all re-join at once.

@@ -123,6 +123,9 @@ TEST(AgentConfig, ValidationErrorsNameTheField) {
   EXPECT_EQ(error_of("agent:\n  rejoin_after_s: 0.5\n"),
             "s.yaml:2: agent.rejoin_after_s = 0.5: must be in [2, 3600]");
   EXPECT_EQ(error_of("agent:\n  rejoin_after_s: 0\n"), "");
+  EXPECT_EQ(error_of("agent:\n  handshake_timeout_s: 1\n"),
+            "s.yaml:2: agent.handshake_timeout_s = 1: must be in [2, 3600]");
+  EXPECT_EQ(error_of("agent:\n  handshake_timeout_s: 0\n"), "");
   EXPECT_NE(
       error_of("agent:\n  activation:\n    repulsion_gain: 0.1\n")
           .find("s.yaml:3: agent.activation.repulsion_gain = 0.1: must be >= attraction_gain"),

@@ -88,18 +88,22 @@ int main(int argc, char** argv) {
       using ddswarm::agent::AgentApp;
       // A new participant each time no scene came (agent.rejoin_after_s), SIGUSR1 asked for one,
       // this process outlived its DDS lease (stopped or starved), the server did not hear it or
-      // it did not hear the server. RejoinPolicy sets each join's scene wait and, once this
+      // it did not hear the server, or a secure server's handshake did not end
+      // (agent.handshake_timeout_s). RejoinPolicy sets each join's waits and, once this
       // agent was cut off, leaves the shared-memory transport out (docs/faults.md).
       ddswarm::agent::RejoinPolicy policy(cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
-                                          cfg.dds.shared_memory && cfg.dds.shm_transport);
+                                          cfg.dds.shared_memory && cfg.dds.shm_transport,
+                                          cfg.agent.handshake_timeout_s);
       ddswarm::keep_joining(duration_s, [&](double left) {
         auto join = cfg;  // the user's configuration stays as given
         join.agent.rejoin_after_s = policy.scene_wait_s();
+        join.agent.handshake_timeout_s = policy.handshake_wait_s();
         if (!policy.shm_transport()) join.dds.shm_transport = false;
         AgentApp agent(join);
         const auto end = agent.run(left);
         const bool cut_off = end == AgentApp::End::kUnheard || end == AgentApp::End::kDeaf;
-        if (policy.ended(cut_off, end == AgentApp::End::kNoScene, agent.heard_scene()))
+        if (policy.ended(cut_off, end == AgentApp::End::kNoScene, agent.heard_scene(),
+                         end == AgentApp::End::kSecureStall))
           spdlog::warn("ddswarm-agent: joining again without the shared-memory transport (UDP "
                        "on 127.0.0.1; the swarm state still by data-sharing): the server may "
                        "listen on shared-memory ports no new sender reaches (docs/dds.md)");

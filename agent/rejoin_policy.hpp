@@ -13,30 +13,41 @@ class RejoinPolicy {
 
   /// rejoin_after_s: agent.rejoin_after_s (0 = never re-join for want of a
   /// scene); lease_s: dds.lease_duration_s; shm_transport: whether the
-  /// user's configuration uses the shared-memory transport.
-  RejoinPolicy(double rejoin_after_s, double lease_s, bool shm_transport)
-      : rejoin_after_s_(rejoin_after_s), lease_s_(lease_s), shm_(shm_transport) {}
+  /// user's configuration uses the shared-memory transport;
+  /// handshake_timeout_s: agent.handshake_timeout_s (0 = never).
+  RejoinPolicy(double rejoin_after_s, double lease_s, bool shm_transport,
+               double handshake_timeout_s = 0)
+      : rejoin_after_s_(rejoin_after_s),
+        lease_s_(lease_s),
+        handshake_s_(handshake_timeout_s),
+        shm_(shm_transport) {}
 
   /// The next join's scene wait (its agent.rejoin_after_s). Each join in a
   /// row that heard no scene waits twice as long as the one before
   /// (rejoin_patience_s), except right after a join that had the scene.
   double scene_wait_s() const;
+  /// The next join's agent.handshake_timeout_s: twice as long after each
+  /// join in a row that ended so (secure_stall), at most 8 times.
+  double handshake_wait_s() const;
   /// Whether the next join uses the shared-memory transport.
   bool shm_transport() const { return shm_; }
 
   /// How the join that scene_wait_s() planned ended. cut_off: the server did
   /// not hear it, or it did not hear the server (kUnheard, kDeaf); no_scene:
-  /// no scene within its wait (kNoScene); heard_scene: it had the scene.
+  /// no scene within its wait (kNoScene); heard_scene: it had the scene;
+  /// secure_stall: a secure server's handshake with it did not end
+  /// (kSecureStall).
   /// Returns true when this end turns the shared-memory transport off for
   /// every later join: Fast DDS 2.9 can leave the server listening on
   /// shared-memory ports whose files a stall made anew and removed, which
   /// no new sender reaches, while UDP reaches it (docs/dds.md).
-  bool ended(bool cut_off, bool no_scene, bool heard_scene);
+  bool ended(bool cut_off, bool no_scene, bool heard_scene, bool secure_stall = false);
 
  private:
-  double rejoin_after_s_, lease_s_;
+  double rejoin_after_s_, lease_s_, handshake_s_;
   bool shm_;
   int no_scene_ = 0;          ///< joins in a row that heard no scene
+  int secure_stalls_ = 0;     ///< joins in a row that ended in kSecureStall
   bool had_scene_ = false;    ///< the last join had the scene
 };
 

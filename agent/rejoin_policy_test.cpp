@@ -56,5 +56,24 @@ TEST(RejoinPolicy, ZeroWaitAndNoSharedMemoryStayAsConfigured) {
   EXPECT_FALSE(udp.shm_transport());
 }
 
+// mp_secure_handshake_stall: under DDS Security the server announced itself,
+// yet its handshake with this participant never ended. The
+// next join waits twice as long, and so on up to 8 times; any other end
+// starts the count again. Such an end leaves the scene wait as it was.
+TEST(RejoinPolicy, SecureStallsInARowWaitTwiceAsLongEachTime) {
+  RejoinPolicy p(40.0, 3.0, false, 10.0);
+  EXPECT_DOUBLE_EQ(p.handshake_wait_s(), 10.0);
+  for (double want : {20.0, 40.0, 80.0, 80.0}) {
+    EXPECT_FALSE(p.ended(false, false, false, true));
+    EXPECT_DOUBLE_EQ(p.handshake_wait_s(), want);
+    EXPECT_DOUBLE_EQ(p.scene_wait_s(), 40.0);
+  }
+  EXPECT_FALSE(p.ended(false, false, true));  // flew, then asked to join again
+  EXPECT_DOUBLE_EQ(p.handshake_wait_s(), 10.0);
+  RejoinPolicy never(40.0, 3.0, false);
+  EXPECT_FALSE(never.ended(false, false, false, true));
+  EXPECT_DOUBLE_EQ(never.handshake_wait_s(), 0.0);
+}
+
 }  // namespace
 }  // namespace ddswarm::agent
