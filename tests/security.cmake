@@ -6,3 +6,9 @@ target_link_libraries(secure_probe PRIVATE ddswarm_common)
 
 ddswarm_process_test(mp_secure_swarm 90 secure_swarm_test.sh)
 ddswarm_process_test(mp_secure_per_drone 90 secure_per_drone_test.sh)
+# An LD_PRELOAD fault: the first participant of a process never gets a
+# handshake message through (tests/stall_handshake.cpp).
+add_library(stall_handshake MODULE stall_handshake.cpp)
+target_link_libraries(stall_handshake PRIVATE ${CMAKE_DL_LIBS})
+set_target_properties(stall_handshake PROPERTIES PREFIX "" LIBRARY_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin)
+ddswarm_process_test(mp_secure_handshake_stall 120 secure_handshake_stall_test.sh)
