@@ -606,7 +606,7 @@ struct AgentApp::Impl {
     const double spread =
         1.0 + AgentConfig::kRejoinSpread * static_cast<double>(brains[0]->instance % 1024) / 1024.0;
     const double patience = cfg.agent.rejoin_after_s * spread;
-    const double secure_patience = cfg.agent.handshake_timeout_s * spread;
+    const double handshake_patience = cfg.agent.handshake_timeout_s * spread;
     double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
@@ -688,13 +688,13 @@ struct AgentApp::Impl {
         if (!scene && cfg.agent.handshake_timeout_s > 0) {
           const auto server = dds.secure_peer(kServerParticipantName);
           if (server && server->authenticated_after_s < 0 &&
-              server->announced_s > secure_patience) {
+              server->announced_s > handshake_patience) {
             spdlog::warn(
                 "{}: the server announced itself {:.1f} s ago and its authentication "
                 "handshake with this participant has not ended; leaving DDS and joining "
                 "again as a new participant",
                 label, server->announced_s);
-            return AgentApp::End::kSecureStall;
+            return AgentApp::End::kHandshakeStall;
           }
         }
         // Fast DDS 2.9 sometimes never matches one of 128 participants that

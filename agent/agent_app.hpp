@@ -49,7 +49,7 @@ class AgentApp {
     kOutlivedLease,
     kUnheard,
     kDeaf,
-    kSecureStall
+    kHandshakeStall
   };
   /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
   /// kStopped. kNoScene when no scene came within agent.rejoin_after_s of
@@ -59,7 +59,7 @@ class AgentApp {
   /// kUnheard when the server's samples have said for twice that lease that
   /// it hears none of this process's answers, kDeaf when no swarm state came
   /// for twice that lease while the server's scene writer stayed matched,
-  /// kSecureStall when, under DDS Security, the server announced itself
+  /// kHandshakeStall when, under DDS Security, the server announced itself
   /// agent.handshake_timeout_s ago, no scene came and its authentication
   /// handshake with this participant has not ended:
   /// the caller should destroy this app and join again.

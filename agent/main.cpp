@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
         const auto end = agent.run(left);
         const bool cut_off = end == AgentApp::End::kUnheard || end == AgentApp::End::kDeaf;
         if (policy.ended(cut_off, end == AgentApp::End::kNoScene, agent.heard_scene(),
-                         end == AgentApp::End::kSecureStall))
+                         end == AgentApp::End::kHandshakeStall))
           spdlog::warn("ddswarm-agent: joining again without the shared-memory transport (UDP "
                        "on 127.0.0.1; the swarm state still by data-sharing): the server may "
                        "listen on shared-memory ports no new sender reaches (docs/dds.md)");

@@ -13,11 +13,11 @@ double RejoinPolicy::scene_wait_s() const {
 }
 
 double RejoinPolicy::handshake_wait_s() const {
-  return rejoin_patience_s(handshake_s_, secure_stalls_);
+  return rejoin_patience_s(handshake_s_, handshake_stalls_);
 }
 
-bool RejoinPolicy::ended(bool cut_off, bool no_scene, bool heard_scene, bool secure_stall) {
-  secure_stalls_ = secure_stall ? secure_stalls_ + 1 : 0;
+bool RejoinPolicy::ended(bool cut_off, bool no_scene, bool heard_scene, bool handshake_stall) {
+  handshake_stalls_ = handshake_stall ? handshake_stalls_ + 1 : 0;
   const bool rejoined_swarm = had_scene_ && rejoin_after_s_ > 0;
   const bool lost = cut_off || (rejoined_swarm && no_scene);
   no_scene_ = no_scene ? no_scene_ + 1 : 0;

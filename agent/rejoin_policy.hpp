@@ -27,7 +27,7 @@ class RejoinPolicy {
   /// (rejoin_patience_s), except right after a join that had the scene.
   double scene_wait_s() const;
   /// The next join's agent.handshake_timeout_s: twice as long after each
-  /// join in a row that ended so (secure_stall), at most 8 times.
+  /// join in a row that ended so (handshake_stall), at most 8 times.
   double handshake_wait_s() const;
   /// Whether the next join uses the shared-memory transport.
   bool shm_transport() const { return shm_; }
@@ -35,19 +35,19 @@ class RejoinPolicy {
   /// How the join that scene_wait_s() planned ended. cut_off: the server did
   /// not hear it, or it did not hear the server (kUnheard, kDeaf); no_scene:
   /// no scene within its wait (kNoScene); heard_scene: it had the scene;
-  /// secure_stall: a secure server's handshake with it did not end
-  /// (kSecureStall).
+  /// handshake_stall: a secure server's handshake with it did not end
+  /// (kHandshakeStall).
   /// Returns true when this end turns the shared-memory transport off for
   /// every later join: Fast DDS 2.9 can leave the server listening on
   /// shared-memory ports whose files a stall made anew and removed, which
   /// no new sender reaches, while UDP reaches it (docs/dds.md).
-  bool ended(bool cut_off, bool no_scene, bool heard_scene, bool secure_stall = false);
+  bool ended(bool cut_off, bool no_scene, bool heard_scene, bool handshake_stall = false);
 
  private:
   double rejoin_after_s_, lease_s_, handshake_s_;
   bool shm_;
   int no_scene_ = 0;          ///< joins in a row that heard no scene
-  int secure_stalls_ = 0;     ///< joins in a row that ended in kSecureStall
+  int handshake_stalls_ = 0;  ///< joins in a row that ended in kHandshakeStall
   bool had_scene_ = false;    ///< the last join had the scene
 };
 

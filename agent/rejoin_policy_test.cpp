@@ -60,7 +60,7 @@ TEST(RejoinPolicy, ZeroWaitAndNoSharedMemoryStayAsConfigured) {
 // yet its handshake with this participant never ended. The
 // next join waits twice as long, and so on up to 8 times; any other end
 // starts the count again. Such an end leaves the scene wait as it was.
-TEST(RejoinPolicy, SecureStallsInARowWaitTwiceAsLongEachTime) {
+TEST(RejoinPolicy, HandshakeStallsInARowWaitTwiceAsLongEachTime) {
   RejoinPolicy p(40.0, 3.0, false, 10.0);
   EXPECT_DOUBLE_EQ(p.handshake_wait_s(), 10.0);
   for (double want : {20.0, 40.0, 80.0, 80.0}) {
