@@ -89,6 +89,16 @@ fly_six_own_server() {
   gs takeoff --wait || fail "takeoff"
 }
 
+# secure_swarm_setup N: DDS Security for N agents (docs/security.md): the
+# secure test scenario, certificates in $C for this test's domain, and gs as
+# the authenticated ground station.
+secure_swarm_setup() {
+  scenario="$SRC/tests/scenarios/secure_small.yaml"  # 3 drones unless told, real time
+  C="$WORK/certs"
+  "$SRC/scripts/make-certs" --out "$C" --agents "$1" --domain "$DOMAIN" || fail "make-certs failed"
+  gs() { timeout 40 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" --secure "$C" "$@"; }
+}
+
 # probe_swarm N: 5 s of swarm_probe --ages on a flying swarm of N, printed;
 # probe_val KEY then prints one of its figures (rtf, age_p99_periods, ...).
 probe_swarm() {

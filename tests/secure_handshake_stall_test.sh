@@ -7,10 +7,7 @@
 # with that handshake still pending, and the swarm, that agent included,
 # takes off. The other agents never leave DDS.
 source "$(dirname "$0")/lib.sh"
-scenario="$SRC/tests/scenarios/secure_small.yaml"  # 3 drones, real time
-C="$WORK/certs"
-"$SRC/scripts/make-certs" --out "$C" --agents 3 --domain "$DOMAIN" || fail "make-certs failed"
-gs() { timeout 40 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" --secure "$C" "$@"; }
+secure_swarm_setup 3
 common=(--config "$scenario" --drones 3 --domain "$DOMAIN" --secure "$C")
 # The sanitizer builds' runtime must load first; the fault library goes after it.
 export ASAN_OPTIONS="${ASAN_OPTIONS:-}:verify_asan_link_order=0"

@@ -8,10 +8,7 @@
 # and the real agent binary started for drone 3 with agent-2's identity
 # cannot fly it.
 source "$(dirname "$0")/lib.sh"
-scenario="$SRC/tests/scenarios/secure_small.yaml"
-C="$WORK/certs"
-"$SRC/scripts/make-certs" --out "$C" --agents 4 --domain "$DOMAIN" || fail "make-certs failed"
-gs() { timeout 40 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" --secure "$C" "$@"; }
+secure_swarm_setup 4
 xy() { gs status --drones | awk -v d="$1" '$1 == d && NF >= 8 { print $2, $3 }'; }
 moved() { /usr/bin/python3 -c "import math; a=list(map(float,'$1'.split())); b=list(map(float,'$2'.split())); print('%.3f' % math.dist(a,b))"; }
 impostors() { gs status | sed -n 's/.*impostor \([0-9]*\).*/\1/p'; }

@@ -4,10 +4,7 @@
 # A participant without credentials sees no topic and cannot move a drone;
 # the recorder's identity is refused a writer.
 source "$(dirname "$0")/lib.sh"
-scenario="$SRC/tests/scenarios/secure_small.yaml"  # 3 drones, real time
-C="$WORK/certs"
-"$SRC/scripts/make-certs" --out "$C" --agents 3 --domain "$DOMAIN" || fail "make-certs failed"
-gs() { timeout 40 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" --secure "$C" "$@"; }
+secure_swarm_setup 3
 # "x y" of drone $1 as the authenticated ground station sees it.
 xy() { gs status --drones | awk -v d="$1" '$1 == d && NF >= 8 { print $2, $3 }'; }
 moved() { /usr/bin/python3 -c "import math,sys; a=list(map(float,'$1'.split())); b=list(map(float,'$2'.split())); print('%.3f' % math.dist(a,b))"; }
