@@ -108,6 +108,10 @@ void DdsConfig::validate() const {
                        "a discovery server on another host needs this host's address on that network "
                        "(--dds-local-ip)");
   }
+  if (secure() && discovery == Discovery::kDiscoveryServer)
+    throw FieldError("dds.discovery_server", discovery_server,
+                     "cannot be used with DDS Security (--secure): Fast DDS 2.9 has no secure "
+                     "discovery server (docs/security.md)");
   if (secure()) {
     if (security_role.empty() ||
         security_role.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=

@@ -39,6 +39,12 @@ int rtps_unicast_port(int domain_id, int participant_id);
 /// domain 0, 62 at domain 232). Fast DDS's automatic ids try only ~100.
 int max_participant_id(int domain_id);
 
+/// Participant ids below this are kept for the server and tools, which take
+/// automatic ids from 0 up; an agent's is this plus its drone id where one is
+/// given: the launcher's for large swarms, and a secure agent's own
+/// (DdsConfig::announce_to_tools_only).
+constexpr int kAgentParticipantIdBase = 32;
+
 /// The participants' lease (dds.lease_duration_s) in a swarm for which
 /// ddswarm-launch starts a discovery server, unless its scenario names one,
 /// and in bench/dds_floor's discovery-server runs. At the default 3 s, 2 of
@@ -132,6 +138,15 @@ struct DdsConfig {
   /// s between this participant's announcements, < lease; 0: a third of the
   /// lease. Set by the binary (one_shot), not read from YAML.
   double announcement_period_s = 0.0;
+  /// Localhost discovery without shared memory (so under DDS Security): send
+  /// this participant's announcements only to the participant ids below
+  /// kAgentParticipantIdBase, where the server and tools are, instead of to
+  /// every id. Agents set it, so they never discover, and so never
+  /// authenticate with, one another; tools, which announce to every id, still
+  /// find them. At 24 secure drones the agents' handshakes and key exchanges
+  /// with each other kept the swarm from ever coming up (docs/security.md).
+  /// Set by the binary, not read from YAML.
+  bool announce_to_tools_only = false;
   std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles
   /// Real time only: the swarm's own readers of the per-tick streams, the
   /// server's of the velocity commands and each agent's of the swarm state,

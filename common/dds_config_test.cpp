@@ -64,6 +64,23 @@ TEST_F(SecureDir, MissingFilesAreNamedInOneLine) {
   }
 }
 
+// Fast DDS 2.9's discovery server has no DDS Security: a secure client of
+// one aborted on an assertion (SecurityManager.cpp:2272) instead of joining.
+TEST_F(SecureDir, ADiscoveryServerIsRefusedUnderSecurity) {
+  auto c = secure("agent-2");
+  c.discovery = Discovery::kDiscoveryServer;
+  c.discovery_server = "127.0.0.1:11811";
+  try {
+    c.validate();
+    FAIL() << "a secure discovery-server client accepted";
+  } catch (const FieldError& e) {
+    EXPECT_EQ(e.field(), "dds.discovery_server");
+    EXPECT_NE(std::string(e.what()).find("127.0.0.1:11811"), std::string::npos) << e.what();
+  }
+  c.security_dir.clear();
+  EXPECT_NO_THROW(c.validate());
+}
+
 TEST_F(SecureDir, BadOrMissingRoleRejected) {
   EXPECT_THROW(secure("").validate(), FieldError);
   EXPECT_THROW(secure("../agent-2").validate(), FieldError);

@@ -12,9 +12,15 @@
 
 #include <spdlog/spdlog.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -145,8 +151,20 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
 
   switch (cfg.discovery) {
     case Discovery::kLocalhost:
-      // Same-host discovery: SHM multicast plus unicast pings to 127.0.0.1.
-      wp.builtin.initialPeersList.push_back(udp_locator(kLoopback, 0));
+      // Same-host discovery: SHM multicast plus unicast pings to 127.0.0.1,
+      // to every id, or only to the server's and tools' (an agent's, where
+      // unicast pings are all the discovery there is).
+      if (cfg.announce_to_tools_only && !uses_shared_memory(cfg)) {
+        const int ids = std::min(kAgentParticipantIdBase, max_participant_id(cfg.domain_id) + 1);
+        for (int id = 0; id < ids; ++id)
+          wp.builtin.initialPeersList.push_back(
+              udp_locator(kLoopback, rtps_unicast_port(cfg.domain_id, id)));
+        // Nor does it listen for multicast announcements, where loopback carries them.
+        wp.builtin.metatrafficMulticastLocatorList.clear();
+        wp.builtin.metatrafficUnicastLocatorList.push_back(udp_locator(kLoopback, 0));
+      } else {
+        wp.builtin.initialPeersList.push_back(udp_locator(kLoopback, 0));
+      }
       break;
     case Discovery::kInterface:
       udp->interfaceWhiteList.emplace_back(cfg.interface_ip);
@@ -223,6 +241,19 @@ std::string topic_name(const fdds::TopicDescription* t) {
 }
 
 }  // namespace
+
+bool participant_id_taken_here(int domain_id, int participant_id) {
+  const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return false;
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(rtps_unicast_port(domain_id, participant_id)));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const bool taken =
+      bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0 && errno == EADDRINUSE;
+  close(fd);
+  return taken;
+}
 
 bool write_threw(fdds::DataWriter* w, const std::exception& e) {
   if (const std::uint64_t n = count_for_log(g_write_throws))
@@ -314,11 +345,14 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     // had left with. Its discovery server then took the new participant's
     // endpoints for the departed one's ("Writer ... has no associated
     // participant. Skipping") and never matched them, and the agent had to
-    // re-join again (docs/performance.md). Not under DDS Security, whose
-    // authentication derives the prefix itself.
+    // re-join again (docs/performance.md). Under DDS Security too: its
+    // authentication derives the prefix from this one, and a secure agent
+    // joins under the same id every time (kAgentParticipantIdBase + K), so
+    // a re-joined agent had the departed one's GUID, and the server's
+    // handshake with it stayed as stalled as before.
     auto& pp = process_participants();
     std::lock_guard<std::mutex> lock(pp.mu);
-    if (pp.first && !secure_) qos.wire_protocol().prefix = incarnation_prefix(*pp.first, pp.made);
+    if (pp.first) qos.wire_protocol().prefix = incarnation_prefix(*pp.first, pp.made);
     // An automatic id whose shared-memory ports no process left behind: a
     // server restarted after a SIGKILL came up on its dead predecessor's
     // ports, and the agents kept sending into the old ones (shm_clean.hpp).

@@ -157,6 +157,11 @@ class Reader : public fdds::DataReaderListener {
 eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
                                                           std::uint32_t n);
 
+/// Whether a process on this host holds the metatraffic port of
+/// participant_id in domain_id on 127.0.0.1, as a live participant with that
+/// id does.
+bool participant_id_taken_here(int domain_id, int participant_id);
+
 class AuthenticationWatch;
 
 /// A remote participant as seen under DDS Security (Participant::secure_peer).

@@ -303,6 +303,26 @@ TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
   agent.close();
 }
 
+// A secure agent takes participant id kAgentParticipantIdBase + K and refuses
+// to start where a process on this host holds it: another agent for drone K
+// (agent/agent_app.cpp). tests/agents_never_meet_test.sh checks the rest of
+// DdsConfig::announce_to_tools_only, which needs separate processes.
+TEST(Participant, AParticipantIdInUseOnThisHostIsSeenTaken) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.shared_memory = false;
+  cfg.participant_id = kAgentParticipantIdBase + 1;
+  EXPECT_FALSE(participant_id_taken_here(cfg.domain_id, cfg.participant_id));
+  {
+    Participant p(cfg, "participant_test agent 1");
+    EXPECT_TRUE(participant_id_taken_here(cfg.domain_id, cfg.participant_id));
+    EXPECT_FALSE(participant_id_taken_here(cfg.domain_id, cfg.participant_id + 1));
+    p.close();
+  }
+  EXPECT_FALSE(participant_id_taken_here(cfg.domain_id,
+                                         cfg.participant_id));  // free again: a re-join takes it
+}
+
 // dds.shm_transport: false keeps data-sharing delivery of the swarm state
 // and leaves out Fast DDS's shared-memory transport, whose ports are files in
 // /dev/shm named by the RTPS port: every other sample then goes over UDP.

@@ -1,0 +1,40 @@
+// One participant for tests/agents_never_meet_test.sh: writes and reads agent
+// heartbeats for --time s, then prints the most readers and writers it had
+// matched at once. --tools-only announces it as an agent does under DDS Security
+// (DdsConfig::announce_to_tools_only); localhost discovery over UDP only.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+
+#include "common/participant.hpp"
+#include "common/process.hpp"
+
+using namespace ddswarm;
+
+int main(int argc, char** argv) {
+  return run_main("announce_peer", [&]() -> int {
+    CLI::App app{"a participant that counts whom it matched"};
+    DdsConfig dds;
+    dds.shared_memory = false;  // unicast pings are all the discovery there is, as under DDS Security
+    double time_s = 5;
+    app.add_option("--domain", dds.domain_id);
+    app.add_option("--participant-id", dds.participant_id);
+    app.add_flag("--tools-only", dds.announce_to_tools_only);
+    app.add_option("--time", time_s);
+    CLI11_PARSE(app, argc, argv);
+    install_stop_signals();
+    Participant p(dds, "announce_peer");
+    auto w = p.writer<msg::AgentStatus>();
+    auto& r = p.reader<msg::AgentStatus>([](const msg::AgentStatus&, const fdds::SampleInfo&) {});
+    int readers = 0, writers = 0;
+    const double end = wall_seconds() + time_s;
+    while (wall_seconds() < end && !wait_for_stop(std::chrono::milliseconds(100))) {
+      readers = std::max(readers, w.matched());
+      writers = std::max(writers, r.matched());
+    }
+    std::printf("matched readers=%d writers=%d\n", readers, writers);
+    p.close();
+    return 0;
+  });
+}
