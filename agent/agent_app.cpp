@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -200,11 +201,48 @@ struct AgentApp::Impl {
                            : "agent host (" + std::to_string(ids.size()) + " drones)";
   }
 
-  /// The agent's shared-memory outbox and port are sized for the drones it flies.
+  /// Under DDS Security on this host alone, an agent announces itself to the
+  /// server and tools only (DdsConfig::announce_to_tools_only), so agents
+  /// never authenticate with one another: their handshakes and key exchanges,
+  /// N² of them, kept a 24-drone secure swarm from coming up. The duplicate
+  /// probe cannot hear another agent then; the participant id does the job.
+  static bool among_tools_only(const AgentAppConfig& c) {
+    return c.dds.secure() && c.dds.discovery == Discovery::kLocalhost && c.drone_ids.size() == 1;
+  }
+
+  /// The agent's shared-memory outbox and port are sized for the drones it
+  /// flies. Among tools only, drone K takes participant id
+  /// kAgentParticipantIdBase + K unless told one. Where a process on this
+  /// host holds it, another agent flies drone K (throws DuplicateAgent);
+  /// unless its port lies in the kernel's ephemeral range, where any
+  /// outgoing socket may hold it: then Fast DDS picks an id, and this agent
+  /// hears and is heard by the other agents, at their cost.
   static DdsConfig dds_for(const AgentAppConfig& c) {
     DdsConfig d = c.dds;
     d.shm_segment_bytes = agent_shm_segment_bytes(c.drone_ids.size());
     d.shm_port_queue = agent_shm_port_queue(c.drone_ids.size());
+    if (among_tools_only(c)) {
+      d.announce_to_tools_only = true;
+      const int id = kAgentParticipantIdBase + c.drone_ids[0];
+      if (d.participant_id < 0 && id <= max_participant_id(d.domain_id)) {
+        d.participant_id = id;
+        if (participant_id_taken_here(d.domain_id, id)) {
+          const int port = rtps_unicast_port(d.domain_id, id);
+          int lo = 0, hi = -1;
+          std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> lo >> hi;
+          if (port < lo || port > hi)
+            throw DuplicateAgent(fmt::format(
+                "drone {} is already flown on this host: a process holds its participant id {} "
+                "(UDP 127.0.0.1:{}); if it is no agent, give this one --participant-id",
+                c.drone_ids[0], id, port));
+          spdlog::warn("drone {}: participant id {}'s port {} is held, and lies in the kernel's "
+                       "ephemeral port range, where any socket may hold it; Fast DDS picks an id "
+                       "instead (docs/security.md)",
+                       c.drone_ids[0], id, port);
+          d.participant_id = -1;
+        }
+      }
+    }
     return d;
   }
 
@@ -227,7 +265,8 @@ struct AgentApp::Impl {
       by_id[id] = brains.back().get();
     }
     Reader<msg::AgentStatus>* probe = nullptr;
-    if (cfg.duplicate_probe_s > 0)
+    const bool probe_agents = cfg.duplicate_probe_s > 0 && !among_tools_only(cfg);
+    if (probe_agents)
       probe =
           &dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& s, const fdds::SampleInfo&) {
             std::lock_guard<std::mutex> lock(mu);
@@ -241,7 +280,7 @@ struct AgentApp::Impl {
       on_scene(s, info.sample_identity.writer_guid().guidPrefix);
     });
     // Listen before speaking: refuse to fly a drone another agent already flies.
-    wait_for_stop(std::chrono::duration<double>(cfg.duplicate_probe_s));
+    if (probe_agents) wait_for_stop(std::chrono::duration<double>(cfg.duplicate_probe_s));
     {
       std::lock_guard<std::mutex> lock(mu);
       for (const auto& b : brains)
@@ -667,11 +706,17 @@ struct AgentApp::Impl {
         // is a reader that lost or never matched the server's swarm-state
         // writer: a new participant is discovered afresh. The count starts
         // again when the server is matched again: one that was away longer
-        // than its lease comes back a moment before its states.
+        // than its lease comes back a moment before its states. Under DDS
+        // Security, at least agent.handshake_timeout_s: the server's swarm
+        // state needs its own key exchange after the scene's, which took
+        // longer than twice the lease in a 32-drone secure launch.
         if (scene && scenes->matched() > 0) {
           const double deaf =
               wall_seconds() - std::max({last_sample_wall, scene_wall, scenes->matched_since()});
-          if (deaf > 2 * cfg.dds.lease_duration_s) {
+          const double patience =
+              dds.secure() ? std::max(2 * cfg.dds.lease_duration_s, cfg.agent.handshake_timeout_s)
+                           : 2 * cfg.dds.lease_duration_s;
+          if (deaf > patience) {
             spdlog::warn(
                 "{}: no swarm state from the server for {:.1f} s while its scene writer is "
                 "still matched: this participant does not hear the server; leaving DDS and "

@@ -91,9 +91,10 @@ int main(int argc, char** argv) {
       // it did not hear the server, or a secure server's handshake did not end
       // (agent.handshake_timeout_s). RejoinPolicy sets each join's waits and, once this
       // agent was cut off, leaves the shared-memory transport out (docs/faults.md).
-      ddswarm::agent::RejoinPolicy policy(cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
-                                          cfg.dds.shared_memory && cfg.dds.shm_transport,
-                                          cfg.agent.handshake_timeout_s);
+      ddswarm::agent::RejoinPolicy policy(
+          cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
+          cfg.dds.shared_memory && cfg.dds.shm_transport && !cfg.dds.secure(),
+          cfg.agent.handshake_timeout_s);
       ddswarm::keep_joining(duration_s, [&](double left) {
         auto join = cfg;  // the user's configuration stays as given
         join.agent.rejoin_after_s = policy.scene_wait_s();

@@ -201,6 +201,11 @@ int main(int argc, char** argv) {
     } catch (const std::invalid_argument&) {
       throw FieldError("--discovery-server", ds_text, "must be auto, on, off or IPv4:port");
     }
+    if (dds.secure() && (ds.kind == DiscoveryServerChoice::Kind::kOn ||
+                         ds.kind == DiscoveryServerChoice::Kind::kExternal))
+      throw FieldError("--discovery-server", ds_text,
+                       "cannot be used with --secure: Fast DDS 2.9 has no secure discovery server "
+                       "(docs/security.md)");
     // Flags every child shares: the domain and the network opt-ins, verbatim.
     std::vector<std::string> dds_args;
     if (ds.kind == DiscoveryServerChoice::Kind::kExternal) {
@@ -224,8 +229,10 @@ int main(int argc, char** argv) {
     install_stop_signals();
     DeathPolicy death_policy(parse_on_death(on_death));
     Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
+    // Not under DDS Security: Fast DDS 2.9's discovery server has none.
     const bool localhost_discovery = file.dds.discovery == Discovery::kLocalhost &&
-                                     !app.count("--dds-interface") && !app.count("--dds-peers");
+                                     !app.count("--dds-interface") && !app.count("--dds-peers") &&
+                                     !dds.secure();
     // What discovery scales with is participants: with agent hosts, a few.
     const int participants = agent_hosts > 0 ? std::min<int>(agent_hosts, n) + 1 : n;
     if (wants_local_discovery_server(ds, participants, only == "all" && ids_text.empty(), localhost_discovery)) {

@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/dds_config.hpp"
 #include "common/id_ranges.hpp"
 
 namespace ddswarm::gs {
@@ -176,7 +177,7 @@ constexpr int kAutoDiscoveryServerAbove = 32;
 /// agents: with 4 free, the fifth tool of a 128-process swarm never found the
 /// server. 32 leaves room for them all.
 constexpr int kExplicitParticipantIdsAbove = 90;
-constexpr int kFirstAgentParticipantId = 32;
+constexpr int kFirstAgentParticipantId = kAgentParticipantIdBase;  // common/dds_config.hpp
 constexpr int kMaxParticipantId = 1100;  ///< 1024 drones and then some; dds.participant_id also bounds it by domain (common/dds_config)
 
 /// The RTPS participant id the launcher gives drone_id's agent in a swarm of

@@ -37,8 +37,9 @@ echo "impostor commands counted: $n0 -> $n1; drone 3 moved $d m while agent-2 co
 awk -v d="$d" 'BEGIN { exit !(d < 0.3) }' || fail "drone 3 moved under agent-2's commands ($p0 -> $p1)"
 
 # The agent binary for drone 3 with agent-2's identity stops with a clear error.
+# (Its own participant id: drone 3's is the real agent's, and an agent refuses a taken one.)
 out=$(timeout 30 "$BIN/ddswarm-agent" --id 3 --config "$scenario" --drones 4 --domain "$DOMAIN" \
-  --secure "$C" --security-role agent-2 --duration 5 2>&1); rc=$?
+  --secure "$C" --security-role agent-2 --participant-id 31 --duration 5 2>&1); rc=$?
 echo "$out" | tail -2
 [ $rc -ne 0 ] && echo "$out" | grep -q "cannot create writer for ddswarm/velocity_cmd.*agent-2.*drone/3" ||
   fail "an agent with agent-2's identity was allowed to fly drone 3 (exit $rc)"
