@@ -8,7 +8,6 @@
 #include <condition_variable>
 #include <deque>
 #include <exception>
-#include <fstream>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -228,9 +227,7 @@ struct AgentApp::Impl {
         d.participant_id = id;
         if (participant_id_taken_here(d.domain_id, id)) {
           const int port = rtps_unicast_port(d.domain_id, id);
-          int lo = 0, hi = -1;
-          std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> lo >> hi;
-          if (port < lo || port > hi)
+          if (!ephemeral_port_range().contains(port))
             throw DuplicateAgent(fmt::format(
                 "drone {} is already flown on this host: a process holds its participant id {} "
                 "(UDP 127.0.0.1:{}); if it is no agent, give this one --participant-id",

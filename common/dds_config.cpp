@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <ifaddrs.h>
 #include <netinet/in.h>
 
@@ -56,6 +57,12 @@ void load(YamlSection s, DdsConfig& c) {
 int rtps_unicast_port(int domain_id, int participant_id) {
   return rtps_port_base(domain_id) + 10 + 2 * participant_id;
 }
+PortRange ephemeral_port_range() {
+  PortRange r;
+  std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> r.lo >> r.hi;
+  return r;
+}
+
 int max_participant_id(int domain_id) { return (65535 - 1 - rtps_unicast_port(domain_id, 0)) / 2; }
 
 std::uint32_t agent_shm_segment_bytes(std::size_t drones) {

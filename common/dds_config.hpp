@@ -39,6 +39,15 @@ int rtps_unicast_port(int domain_id, int participant_id);
 /// domain 0, 62 at domain 232). Fast DDS's automatic ids try only ~100.
 int max_participant_id(int domain_id);
 
+/// The kernel's ephemeral port range (/proc/sys/net/ipv4/ip_local_port_range):
+/// any process's outgoing socket may hold a port inside it. Empty ({0, -1})
+/// when it cannot be read.
+struct PortRange {
+  int lo = 0, hi = -1;
+  bool contains(int port) const { return port >= lo && port <= hi; }
+};
+PortRange ephemeral_port_range();
+
 /// Participant ids below this are kept for the server and tools, which take
 /// automatic ids from 0 up; an agent's is this plus its drone id where one is
 /// given: the launcher's for large swarms, and a secure agent's own

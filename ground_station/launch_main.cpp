@@ -296,10 +296,9 @@ int main(int argc, char** argv) {
                                "(dds.participant_id stops at {}; docs/performance.md)\n",
                                n, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
     if (agent_hosts == 0 && !ids.empty() && agent_participant_id(n, ids.front()) >= 0) {
-      int lo = 0, hi = -1;
-      std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> lo >> hi;
+      const PortRange eph = ephemeral_port_range();
       const std::string w = ephemeral_port_warning(dds.domain_id, agent_participant_id(n, ids.front()),
-                                                   agent_participant_id(n, ids.back()), lo, hi);
+                                                   agent_participant_id(n, ids.back()), eph.lo, eph.hi);
       if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
     }
     // The whole swarm with its server (not --ids, --only): agent_command's
