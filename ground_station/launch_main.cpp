@@ -229,13 +229,13 @@ int main(int argc, char** argv) {
     install_stop_signals();
     DeathPolicy death_policy(parse_on_death(on_death));
     Launcher procs(gs_interactive && log_dir.empty() ? "ddswarm-logs" : log_dir);
-    // Not under DDS Security: Fast DDS 2.9's discovery server has none.
     const bool localhost_discovery = file.dds.discovery == Discovery::kLocalhost &&
-                                     !app.count("--dds-interface") && !app.count("--dds-peers") &&
-                                     !dds.secure();
+                                     !app.count("--dds-interface") && !app.count("--dds-peers");
     // What discovery scales with is participants: with agent hosts, a few.
     const int participants = agent_hosts > 0 ? std::min<int>(agent_hosts, n) + 1 : n;
-    if (wants_local_discovery_server(ds, participants, only == "all" && ids_text.empty(), localhost_discovery)) {
+    // Not under DDS Security: Fast DDS 2.9's discovery server has none.
+    if (wants_local_discovery_server(ds, participants, only == "all" && ids_text.empty(),
+                                     localhost_discovery && !dds.secure())) {
       // First, so every participant finds it; clients retry until it answers.
       const int port = free_udp_port();
       const ChildSpec ds_spec = discovery_server_spec(port);
