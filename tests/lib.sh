@@ -99,6 +99,11 @@ secure_swarm_setup() {
   gs() { timeout 40 "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" --secure "$C" "$@"; }
 }
 
+# xy K: "x y" of drone K as the test's ground station (gs) sees it;
+# moved "X0 Y0" "X1 Y1": the distance between two such positions, in m.
+xy() { gs status --drones | awk -v d="$1" '$1 == d && NF >= 8 { print $2, $3 }'; }
+moved() { /usr/bin/python3 -c "import math; a=list(map(float,'$1'.split())); b=list(map(float,'$2'.split())); print('%.3f' % math.dist(a,b))"; }
+
 # probe_swarm N: 5 s of swarm_probe --ages on a flying swarm of N, printed;
 # probe_val KEY then prints one of its figures (rtf, age_p99_periods, ...).
 probe_swarm() {

@@ -9,8 +9,6 @@
 # cannot fly it.
 source "$(dirname "$0")/lib.sh"
 secure_swarm_setup 4
-xy() { gs status --drones | awk -v d="$1" '$1 == d && NF >= 8 { print $2, $3 }'; }
-moved() { /usr/bin/python3 -c "import math; a=list(map(float,'$1'.split())); b=list(map(float,'$2'.split())); print('%.3f' % math.dist(a,b))"; }
 impostors() { gs status | sed -n 's/.*impostor \([0-9]*\).*/\1/p'; }
 
 start launch "$BIN/ddswarm-launch" "$scenario" --drones 4 --domain "$DOMAIN" --secure "$C"

@@ -5,9 +5,6 @@
 # the recorder's identity is refused a writer.
 source "$(dirname "$0")/lib.sh"
 secure_swarm_setup 3
-# "x y" of drone $1 as the authenticated ground station sees it.
-xy() { gs status --drones | awk -v d="$1" '$1 == d && NF >= 8 { print $2, $3 }'; }
-moved() { /usr/bin/python3 -c "import math,sys; a=list(map(float,'$1'.split())); b=list(map(float,'$2'.split())); print('%.3f' % math.dist(a,b))"; }
 
 start record "$BIN/ddswarm-record" --domain "$DOMAIN" --secure "$C" -o "$WORK/run.mcap" --duration 60
 start launch "$BIN/ddswarm-launch" "$scenario" --domain "$DOMAIN" --secure "$C"
