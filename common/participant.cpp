@@ -283,10 +283,10 @@ eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrt
   return p;
 }
 
-/// Under DDS Security, what this participant knows of each remote one, by
-/// GUID: its name, when it announced itself and when it authenticated.
+/// What this participant knows of each live remote one, by GUID: its name,
+/// when it announced itself and, under DDS Security, when it authenticated.
 /// Fed by Fast DDS's threads; the announcement comes before the handshake.
-class AuthenticationWatch : public fdds::DomainParticipantListener {
+class PeerWatch : public fdds::DomainParticipantListener {
  public:
   using ParticipantDiscoveryInfo = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
   using ParticipantAuthenticationInfo = eprosima::fastrtps::rtps::ParticipantAuthenticationInfo;
@@ -309,13 +309,16 @@ class AuthenticationWatch : public fdds::DomainParticipantListener {
       it->second.authenticated_after_s = wall_seconds() - it->second.since;
   }
 
-  std::optional<SecurePeer> oldest(const std::string& name) const {
+  std::vector<RemotePeer> named(const std::string& name) const {
     const std::lock_guard<std::mutex> lock(mu_);
-    std::optional<SecurePeer> found;
+    std::vector<RemotePeer> found;
     const double now = wall_seconds();
     for (const auto& [guid, p] : peers_)
-      if (p.name == name && (!found || now - p.since > found->announced_s))
-        found = SecurePeer{now - p.since, p.authenticated_after_s};
+      if (p.name == name)
+        found.push_back(RemotePeer{guid.guidPrefix, now - p.since, p.authenticated_after_s});
+    std::sort(found.begin(), found.end(), [](const RemotePeer& a, const RemotePeer& b) {
+      return a.announced_s > b.announced_s;
+    });
     return found;
   }
 
@@ -362,12 +365,12 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
           cfg.domain_id, std::min(kInitialPeersRange - 1, max_participant_id(cfg.domain_id)));
     // The watch hears discovery and authentication only (no data status):
     // every reader and writer keeps its own listener.
-    if (secure_) auth_watch_ = std::make_unique<AuthenticationWatch>();
-    participant_ = factory->create_participant(cfg.domain_id, qos, auth_watch_.get(),
+    peer_watch_ = std::make_unique<PeerWatch>();
+    participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
                                                fdds::StatusMask::none());
     if (!participant_ && clear_id && qos.wire_protocol().participant_id >= 0) {
       qos.wire_protocol().participant_id = -1;  // e.g. the id is this process's already: Fast DDS picks
-      participant_ = factory->create_participant(cfg.domain_id, qos, auth_watch_.get(),
+      participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
                                                  fdds::StatusMask::none());
     }
     if (participant_) {
@@ -390,8 +393,15 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   }
 }
 
-std::optional<SecurePeer> Participant::secure_peer(const std::string& name) const {
-  return auth_watch_ ? auth_watch_->oldest(name) : std::nullopt;
+std::optional<RemotePeer> Participant::secure_peer(const std::string& name) const {
+  if (!secure_) return std::nullopt;
+  auto peers = peer_watch_->named(name);
+  if (peers.empty()) return std::nullopt;
+  return peers.front();
+}
+
+std::vector<RemotePeer> Participant::peers_named(const std::string& name) const {
+  return peer_watch_->named(name);
 }
 
 fdds::Publisher* Participant::publisher_for(const std::string& partition) {

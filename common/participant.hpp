@@ -21,6 +21,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/dds_config.hpp"
 #include "common/process.hpp"
@@ -162,13 +163,15 @@ eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrt
 /// id does.
 bool participant_id_taken_here(int domain_id, int participant_id);
 
-class AuthenticationWatch;
+class PeerWatch;
 
-/// A remote participant as seen under DDS Security (Participant::secure_peer).
-struct SecurePeer {
+/// A live remote participant this one discovered (Participant::peers_named).
+struct RemotePeer {
+  eprosima::fastrtps::rtps::GuidPrefix_t prefix;
   double announced_s;  ///< since it announced itself (its discovery data came)
-  /// How long after its announcement its authentication handshake with this
-  /// participant passed; < 0 while it has not (pending, or refused).
+  /// Under DDS Security, how long after its announcement its authentication
+  /// handshake with this participant passed; < 0 while it has not (pending,
+  /// or refused), and always without DDS Security.
   double authenticated_after_s;
 };
 
@@ -264,7 +267,12 @@ class Participant {
   /// Under DDS Security: of the live remote participants named `name`, the one
   /// that announced itself longest ago; none without DDS Security. Fast DDS
   /// 2.9 sometimes leaves a handshake pending for good (docs/security.md).
-  std::optional<SecurePeer> secure_peer(const std::string& name) const;
+  std::optional<RemotePeer> secure_peer(const std::string& name) const;
+  /// The live remote participants named `name` (kServerParticipantName: the
+  /// servers), as discovery announced them, oldest first. An agent whose old
+  /// server went silent learns so that a new one exists even when what the
+  /// new one sends it never arrives (docs/faults.md).
+  std::vector<RemotePeer> peers_named(const std::string& name) const;
   /// True when this participant uses shared memory (the transport and
   /// data-sharing delivery): dds.shared_memory, and neither DDS Security nor
   /// the TSan build.
@@ -294,7 +302,7 @@ class Participant {
     return t;
   }
 
-  std::unique_ptr<AuthenticationWatch> auth_watch_;  // under DDS Security; outlives participant_
+  std::unique_ptr<PeerWatch> peer_watch_;  // outlives participant_
   fdds::DomainParticipant* participant_ = nullptr;
   bool closed_ = false;
   bool secure_ = false;

@@ -276,6 +276,36 @@ TEST(Participant, TheSwarmStateHeartbeatOutlastsEveryLease) {
 // An agent tells a live server from one that was away by when the server's
 // writer was matched again: matched_since() moves only when the count rises
 // from none.
+// An agent learns from discovery alone that a server exists, and which one,
+// even when nothing else of it arrives (docs/faults.md, "An agent deaf to a
+// new server"): by name, oldest first, gone once it leaves.
+TEST(Participant, PeersAreKnownByNameFromDiscoveryAlone) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant agent(cfg, "participant_test agent");
+  EXPECT_TRUE(agent.peers_named("participant_test server").empty());
+  {
+    Participant first(cfg, "participant_test server");
+    ASSERT_TRUE(
+        within(10, [&] { return agent.peers_named("participant_test server").size() == 1; }));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    Participant second(cfg, "participant_test server");
+    Participant tool(cfg, "participant_test tool");
+    ASSERT_TRUE(
+        within(10, [&] { return agent.peers_named("participant_test server").size() == 2; }));
+    const auto servers = agent.peers_named("participant_test server");
+    EXPECT_EQ(servers[0].prefix, first.raw()->guid().guidPrefix);  // oldest first
+    EXPECT_EQ(servers[1].prefix, second.raw()->guid().guidPrefix);
+    EXPECT_GE(servers[0].announced_s, servers[1].announced_s + 0.2);
+    EXPECT_LT(servers[0].authenticated_after_s, 0);  // no DDS Security
+    EXPECT_FALSE(
+        agent.secure_peer("participant_test server"));  // that one is for DDS Security only
+    ASSERT_TRUE(within(10, [&] { return agent.peers_named("participant_test tool").size() == 1; }));
+  }
+  EXPECT_TRUE(within(10, [&] { return agent.peers_named("participant_test server").empty(); }))
+      << "participants that left are still listed";
+}
+
 TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
   DdsConfig cfg;
   cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
