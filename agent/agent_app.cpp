@@ -165,6 +165,8 @@ struct AgentApp::Impl {
   std::uint64_t last_tick = 0;
   bool have_tick = false;
   double last_sample_wall = -1e9;
+  // The last swarm state taken: its writer and that writer's sequence number.
+  eprosima::fastrtps::rtps::SampleIdentity last_state;
   double scene_wall = -1e9;  // when the server's scene came (wall)
   bool server_lost = false;
   // A lost server: the swarm-state reader is made anew (sync_states_reader),
@@ -320,7 +322,7 @@ struct AgentApp::Impl {
     }
     states = &dds.reader<msg::SwarmState>(
         [this](const msg::SwarmState& s, const fdds::SampleInfo& info) {
-          on_swarm(s, info.sample_identity.writer_guid().guidPrefix);
+          on_swarm(s, info.sample_identity);
         },
         std::nullopt, *want);
     states_delivery = *want;
@@ -436,7 +438,8 @@ struct AgentApp::Impl {
   }
 
   /// One server tick: check the sample once, then every drone's brain answers.
-  void on_swarm(const msg::SwarmState& s, const eprosima::fastrtps::rtps::GuidPrefix_t& from) {
+  void on_swarm(const msg::SwarmState& s, const eprosima::fastrtps::rtps::SampleIdentity& id) {
+    const auto& from = id.writer_guid().guidPrefix;
     std::lock_guard<std::mutex> lock(mu);
     if (!scene) return;  // no scene yet
     if (cfg.agent.state_loss > 0 &&
@@ -450,6 +453,16 @@ struct AgentApp::Impl {
       ++rejected;
       return;
     }
+    // A state its writer sent before one already taken: a reader made anew
+    // once the server went silent is handed the server's last state again
+    // (transient-local), though that server may be dead. It is no sign of
+    // life. A lockstep server that publishes a tick again writes it anew.
+    if (id.writer_guid() == last_state.writer_guid() &&
+        id.sequence_number() <= last_state.sequence_number()) {
+      ++rejected;
+      return;
+    }
+    last_state = id;
     if (have_tick && s.tick() < last_tick) {
       if (!server_lost) {  // a restarted server starts again from 0; anything else is stale
         ++rejected;
@@ -707,18 +720,37 @@ struct AgentApp::Impl {
         // Security, at least agent.handshake_timeout_s: the server's swarm
         // state needs its own key exchange after the scene's, which took
         // longer than twice the lease in a 32-drone secure launch.
+        const double deaf_patience =
+            dds.secure() ? std::max(2 * cfg.dds.lease_duration_s, cfg.agent.handshake_timeout_s)
+                         : 2 * cfg.dds.lease_duration_s;
         if (scene && scenes->matched() > 0) {
           const double deaf =
               wall_seconds() - std::max({last_sample_wall, scene_wall, scenes->matched_since()});
-          const double patience =
-              dds.secure() ? std::max(2 * cfg.dds.lease_duration_s, cfg.agent.handshake_timeout_s)
-                           : 2 * cfg.dds.lease_duration_s;
-          if (deaf > patience) {
+          if (deaf > deaf_patience) {
             spdlog::warn(
                 "{}: no swarm state from the server for {:.1f} s while its scene writer is "
                 "still matched: this participant does not hear the server; leaving DDS and "
                 "joining again as a new participant",
                 label, deaf);
+            return AgentApp::End::kDeaf;
+          }
+        }
+        // Deaf to a new server: the old one went silent and another announced
+        // itself, both twice the lease ago, yet no scene came from it. What it
+        // sends this participant does not arrive, though its announcements
+        // do (over UDP): a server SIGKILLed while it held the lock of this
+        // agent's shared-memory port leaves every later message to that port
+        // lost (docs/faults.md). A new participant listens on new ports.
+        if (scene && server_lost) {
+          const double silent_for = wall_seconds() - last_sample_wall;
+          for (const auto& p : dds.peers_named(kServerParticipantName)) {
+            if (p.prefix == server || std::min(p.announced_s, silent_for) <= deaf_patience)
+              continue;
+            spdlog::warn(
+                "{}: a new server announced itself {:.1f} s ago, the last one has been silent "
+                "for {:.1f} s, and no scene came from the new one: this participant does not "
+                "hear it; leaving DDS and joining again as a new participant",
+                label, p.announced_s, silent_for);
             return AgentApp::End::kDeaf;
           }
         }

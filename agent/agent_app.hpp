@@ -58,7 +58,9 @@ class AgentApp {
   /// its DDS lease (dds.lease_duration_s), so its peers may have dropped it,
   /// kUnheard when the server's samples have said for twice that lease that
   /// it hears none of this process's answers, kDeaf when no swarm state came
-  /// for twice that lease while the server's scene writer stayed matched,
+  /// for twice that lease while the server's scene writer stayed matched, or
+  /// while the last server has been silent and a new one announced, both for
+  /// twice that lease, and no scene came from the new one,
   /// kHandshakeStall when, under DDS Security, the server announced itself
   /// agent.handshake_timeout_s ago, no scene came and its authentication
   /// handshake with this participant has not ended:

@@ -1,11 +1,13 @@
-// One participant for tests/agents_never_meet_test.sh: writes and reads agent
+// One participant for the multi-process tests: writes and reads agent
 // heartbeats for --time s, then prints the most readers and writers it had
 // matched at once. --tools-only announces it as an agent does under DDS Security
-// (DdsConfig::announce_to_tools_only); localhost discovery over UDP only.
+// (DdsConfig::announce_to_tools_only; tests/agents_never_meet_test.sh); --name
+// names it, e.g. as the server it is not (tests/deaf_to_new_server_test.sh).
+// Localhost discovery over UDP only.
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <cstdio>
+#include <string>
 
 #include "common/participant.hpp"
 #include "common/process.hpp"
@@ -18,13 +20,15 @@ int main(int argc, char** argv) {
     DdsConfig dds;
     dds.shared_memory = false;  // unicast pings are all the discovery there is, as under DDS Security
     double time_s = 5;
+    std::string name = "announce_peer";
     app.add_option("--domain", dds.domain_id);
     app.add_option("--participant-id", dds.participant_id);
     app.add_flag("--tools-only", dds.announce_to_tools_only);
     app.add_option("--time", time_s);
+    app.add_option("--name", name, "the participant's name");
     CLI11_PARSE(app, argc, argv);
     install_stop_signals();
-    Participant p(dds, "announce_peer");
+    Participant p(dds, name);
     auto w = p.writer<msg::AgentStatus>();
     auto& r = p.reader<msg::AgentStatus>([](const msg::AgentStatus&, const fdds::SampleInfo&) {});
     int readers = 0, writers = 0;
