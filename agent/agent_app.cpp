@@ -380,12 +380,14 @@ struct AgentApp::Impl {
     scene = scene_from_msg(s);
     for (const auto& b : brains) start_brain(*b);
     // Under DDS Security, how long the server took (docs/security.md).
-    if (const auto server = dds.secure_peer(kServerParticipantName);
-        server && server->authenticated_after_s >= 0)
+    std::optional<RemotePeer> sender;
+    for (const auto& p : dds.peers_named(kServerParticipantName))
+      if (p.prefix == from && p.authenticated_after_s >= 0) sender = p;
+    if (sender)
       spdlog::info(
           "{}: scene '{}' received, {:.1f} s after the server announced itself (it "
           "authenticated this participant after {:.1f} s)",
-          label, s.name().to_string(), server->announced_s, server->authenticated_after_s);
+          label, s.name().to_string(), sender->announced_s, sender->authenticated_after_s);
     else
       spdlog::info("{}: scene '{}' received", label, s.name().to_string());
     const double reach = sensor_range_m(cfg.agent.sensor_function);
@@ -758,16 +760,16 @@ struct AgentApp::Impl {
         // this participant within a second or two, at 16 drones too; its
         // scene may take longer (rejoin_after_s waits for that). Fast DDS 2.9
         // sometimes leaves a handshake pending for good (docs/security.md):
-        // a new participant starts every handshake afresh.
-        if (!scene && cfg.agent.handshake_timeout_s > 0) {
-          const auto server = dds.secure_peer(kServerParticipantName);
-          if (server && server->authenticated_after_s < 0 &&
-              server->announced_s > handshake_patience) {
+        // a new participant starts every handshake afresh. Any server counts:
+        // a restarted one's predecessor may still be within its lease.
+        if (!scene && dds.secure() && cfg.agent.handshake_timeout_s > 0) {
+          for (const auto& p : dds.peers_named(kServerParticipantName)) {
+            if (p.authenticated_after_s >= 0 || p.announced_s <= handshake_patience) continue;
             spdlog::warn(
                 "{}: the server announced itself {:.1f} s ago and its authentication "
                 "handshake with this participant has not ended; leaving DDS and joining "
                 "again as a new participant",
-                label, server->announced_s);
+                label, p.announced_s);
             return AgentApp::End::kHandshakeStall;
           }
         }

@@ -393,13 +393,6 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   }
 }
 
-std::optional<RemotePeer> Participant::secure_peer(const std::string& name) const {
-  if (!secure_) return std::nullopt;
-  auto peers = peer_watch_->named(name);
-  if (peers.empty()) return std::nullopt;
-  return peers.front();
-}
-
 std::vector<RemotePeer> Participant::peers_named(const std::string& name) const {
   return peer_watch_->named(name);
 }

@@ -264,14 +264,12 @@ class Participant {
   fdds::DomainParticipant* raw() const { return participant_; }
   /// True when DDS Security is on (DdsConfig::security_dir).
   bool secure() const { return secure_; }
-  /// Under DDS Security: of the live remote participants named `name`, the one
-  /// that announced itself longest ago; none without DDS Security. Fast DDS
-  /// 2.9 sometimes leaves a handshake pending for good (docs/security.md).
-  std::optional<RemotePeer> secure_peer(const std::string& name) const;
   /// The live remote participants named `name` (kServerParticipantName: the
   /// servers), as discovery announced them, oldest first. An agent whose old
   /// server went silent learns so that a new one exists even when what the
-  /// new one sends it never arrives (docs/faults.md).
+  /// new one sends it never arrives (docs/faults.md); under DDS Security, that
+  /// a server's handshake with it is still pending, as Fast DDS 2.9 sometimes
+  /// leaves one for good (docs/security.md).
   std::vector<RemotePeer> peers_named(const std::string& name) const;
   /// True when this participant uses shared memory (the transport and
   /// data-sharing delivery): dds.shared_memory, and neither DDS Security nor

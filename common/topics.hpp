@@ -86,7 +86,7 @@ template <>
 inline constexpr bool kPerDronePartition<msg::VelocityCommand> = true;
 
 /// The participant name the simulation server joins DDS under (it shows in
-/// tools; agents look for it under DDS Security: Participant::secure_peer).
+/// tools; agents look for it by name: Participant::peers_named).
 inline constexpr const char* kServerParticipantName = "ddswarm-sim";
 
 /// The per-tick streams, state out and commands back: a newer sample
