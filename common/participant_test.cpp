@@ -273,9 +273,6 @@ TEST(Participant, TheSwarmStateHeartbeatOutlastsEveryLease) {
   p.close();
 }
 
-// An agent tells a live server from one that was away by when the server's
-// writer was matched again: matched_since() moves only when the count rises
-// from none.
 // An agent learns from discovery alone that a server exists, and which one,
 // even when nothing else of it arrives (docs/faults.md, "An agent deaf to a
 // new server"): by name, oldest first, gone once it leaves.
@@ -304,6 +301,9 @@ TEST(Participant, PeersAreKnownByNameFromDiscoveryAlone) {
       << "participants that left are still listed";
 }
 
+// An agent tells a live server from one that was away by when the server's
+// writer was matched again: matched_since() moves only when the count rises
+// from none.
 TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
   DdsConfig cfg;
   cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
