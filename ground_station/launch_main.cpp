@@ -296,9 +296,9 @@ int main(int argc, char** argv) {
                                "(dds.participant_id stops at {}; docs/performance.md)\n",
                                n, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
     if (agent_hosts == 0 && !ids.empty() && agent_participant_id(n, ids.front()) >= 0) {
-      const PortRange eph = ephemeral_port_range();
-      const std::string w = ephemeral_port_warning(dds.domain_id, agent_participant_id(n, ids.front()),
-                                                   agent_participant_id(n, ids.back()), eph.lo, eph.hi);
+      const std::string w =
+          ephemeral_port_warning(dds.domain_id, agent_participant_id(n, ids.front()),
+                                 agent_participant_id(n, ids.back()), ephemeral_port_range());
       if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
     }
     // The whole swarm with its server (not --ids, --only): agent_command's

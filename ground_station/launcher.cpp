@@ -403,7 +403,8 @@ std::vector<std::string> agent_command(const std::string& bin, const std::string
   return a;
 }
 
-std::string ephemeral_port_warning(int domain, int first_id, int last_id, int lo, int hi) {
+std::string ephemeral_port_warning(int domain, int first_id, int last_id, PortRange ephemeral) {
+  const auto [lo, hi] = ephemeral;
   const int low = rtps_unicast_port(domain, first_id), high = rtps_unicast_port(domain, last_id) + 1;
   if (first_id < 0 || last_id < first_id || high < lo || low > hi) return "";
   const int clear_domain = (lo - 1 - rtps_unicast_port(0, last_id) - 1) / 250;  // largest d with every port below lo

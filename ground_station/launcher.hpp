@@ -202,12 +202,12 @@ std::vector<std::string> agent_command(const std::string& bin, const std::string
 
 /// The RTPS unicast ports (metatraffic and user, 7400 + 250*domain + 10/11 +
 /// 2*id) of explicit participant ids [first_id, last_id] that fall inside the
-/// kernel's ephemeral port range [lo, hi] (/proc/sys/net/ipv4/ip_local_port_range).
+/// kernel's ephemeral port range (ephemeral_port_range(), common/dds_config).
 /// Any process's outgoing socket may hold such a port, and the participant that
 /// needs it then never binds it and is never discovered (2 of 128 agents in
 /// domain 120+, docs/performance.md). Returns a one-line warning naming the
 /// largest domain that keeps clear of the range, or "" when clear.
-std::string ephemeral_port_warning(int domain, int first_id, int last_id, int lo, int hi);
+std::string ephemeral_port_warning(int domain, int first_id, int last_id, PortRange ephemeral);
 
 /// True when the launcher should start its own server. `starts_whole_swarm`:
 /// it starts the server and every agent (a local server cannot serve a swarm

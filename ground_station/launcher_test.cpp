@@ -287,13 +287,13 @@ TEST(Launcher, LargeSwarmsAgentsGetExplicitParticipantIds) {
 
 TEST(Launcher, WarnsWhenExplicitIdsUseEphemeralPorts) {
   // 128 agents (ids 32-159) in domain 150: ports 44974-45229, inside Linux's 32768-60999.
-  const std::string w = ephemeral_port_warning(150, 32, 159, 32768, 60999);
+  const std::string w = ephemeral_port_warning(150, 32, 159, {32768, 60999});
   EXPECT_NE(w.find("ports 44974-45229"), std::string::npos) << w;
   EXPECT_NE(w.find("use --domain 100 or lower"), std::string::npos) << w;
   // The advice holds: domain 100 keeps every port below the range; 101 does not.
-  EXPECT_EQ(ephemeral_port_warning(100, 32, 159, 32768, 60999), "");
-  EXPECT_NE(ephemeral_port_warning(101, 32, 159, 32768, 60999), "");
-  EXPECT_EQ(ephemeral_port_warning(0, 4, 1027, 32768, 60999), "");
+  EXPECT_EQ(ephemeral_port_warning(100, 32, 159, {32768, 60999}), "");
+  EXPECT_NE(ephemeral_port_warning(101, 32, 159, {32768, 60999}), "");
+  EXPECT_EQ(ephemeral_port_warning(0, 4, 1027, {32768, 60999}), "");
 }
 
 TEST(Launcher, ParticipantIdsFitTheRtpsPortsOfTheirDomain) {
