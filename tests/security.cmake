@@ -8,8 +8,6 @@ ddswarm_process_test(mp_secure_swarm 90 secure_swarm_test.sh)
 ddswarm_process_test(mp_secure_per_drone 90 secure_per_drone_test.sh)
 ddswarm_process_test(mp_secure_swarm_24 180 secure_swarm_scale_test.sh)
 # Agents that announce themselves to the server and tools only never meet.
-add_executable(announce_peer announce_peer.cpp)
-target_link_libraries(announce_peer PRIVATE ddswarm_common)
 ddswarm_process_test(mp_agents_never_meet 60 agents_never_meet_test.sh)
 # An LD_PRELOAD fault: the first participant of a process never gets a
 # handshake message through (tests/stall_handshake.cpp).
