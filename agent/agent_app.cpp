@@ -656,8 +656,11 @@ struct AgentApp::Impl {
     // so that agents that missed the server do not all join again at once.
     const double spread =
         1.0 + AgentConfig::kRejoinSpread * static_cast<double>(brains[0]->instance % 1024) / 1024.0;
-    const double patience = cfg.agent.rejoin_after_s * spread;
-    const double handshake_patience = cfg.agent.handshake_timeout_s * spread;
+    JoinPatience join_patience;
+    join_patience.lease_s = cfg.dds.lease_duration_s;
+    join_patience.scene_wait_s = cfg.agent.rejoin_after_s * spread;
+    join_patience.handshake_timeout_s = cfg.agent.handshake_timeout_s;
+    join_patience.handshake_wait_s = cfg.agent.handshake_timeout_s * spread;
     double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
       spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
@@ -695,91 +698,23 @@ struct AgentApp::Impl {
           spdlog::warn("{}: no server samples for {:.1f} s; holding commands until it returns",
                        label, silent);
         }
-        // Hearing, but not heard: the server's samples say for a while that
-        // it has no live agent for a drone this process answers for. Its
-        // reader lost this participant one-sidedly (the server was stopped
-        // longer than this agent's lease, or discovery dropped this
-        // participant's endpoints): a new participant is discovered afresh.
-        for (const auto& b : brains) {
-          if (b->unheard_since < 0) continue;  // heard, or the server went silent since
-          const double unheard = wall_seconds() - b->unheard_since;
-          if (unheard > 2 * cfg.dds.lease_duration_s) {
-            spdlog::warn("{}: the server's samples have marked drone {} agent-less for {:.1f} s while "
-                         "this agent answered them: the server does not hear this agent; leaving DDS "
-                         "and joining again as a new participant",
-                         label, b->id, unheard);
-            return AgentApp::End::kUnheard;
-          }
-        }
-        // Deaf to a live server: its scene writer is still matched, yet no
-        // swarm state came for twice the lease. A live server publishes at
-        // least every 0.25 s (lockstep resends, a paused swarm), and one
-        // stopped longer than its lease is dropped with its writers, so this
-        // is a reader that lost or never matched the server's swarm-state
-        // writer: a new participant is discovered afresh. The count starts
-        // again when the server is matched again: one that was away longer
-        // than its lease comes back a moment before its states. Under DDS
-        // Security, at least agent.handshake_timeout_s: the server's swarm
-        // state needs its own key exchange after the scene's, which took
-        // longer than twice the lease in a 32-drone secure launch.
-        const double deaf_patience =
-            dds.secure() ? std::max(2 * cfg.dds.lease_duration_s, cfg.agent.handshake_timeout_s)
-                         : 2 * cfg.dds.lease_duration_s;
-        if (scene && scenes->matched() > 0) {
-          const double deaf =
-              wall_seconds() - std::max({last_sample_wall, scene_wall, scenes->matched_since()});
-          if (deaf > deaf_patience) {
-            spdlog::warn(
-                "{}: no swarm state from the server for {:.1f} s while its scene writer is "
-                "still matched: this participant does not hear the server; leaving DDS and "
-                "joining again as a new participant",
-                label, deaf);
-            return AgentApp::End::kDeaf;
-          }
-        }
-        // Deaf to a new server: the old one went silent and another announced
-        // itself, both twice the lease ago, yet no scene came from it. What it
-        // sends this participant does not arrive, though its announcements
-        // do (over UDP): a server SIGKILLed while it held the lock of this
-        // agent's shared-memory port leaves every later message to that port
-        // lost (docs/faults.md). A new participant listens on new ports.
-        if (scene && server_lost) {
-          const double silent_for = wall_seconds() - last_sample_wall;
-          for (const auto& p : dds.peers_named(kServerParticipantName)) {
-            if (p.prefix == server || std::min(p.announced_s, silent_for) <= deaf_patience)
-              continue;
-            spdlog::warn(
-                "{}: a new server announced itself {:.1f} s ago, the last one has been silent "
-                "for {:.1f} s, and no scene came from the new one: this participant does not "
-                "hear it; leaving DDS and joining again as a new participant",
-                label, p.announced_s, silent_for);
-            return AgentApp::End::kDeaf;
-          }
-        }
-        // Under DDS Security a server that announced itself authenticates
-        // this participant within a second or two, at 16 drones too; its
-        // scene may take longer (rejoin_after_s waits for that). Fast DDS 2.9
-        // sometimes leaves a handshake pending for good (docs/security.md):
-        // a new participant starts every handshake afresh. Any server counts:
-        // a restarted one's predecessor may still be within its lease.
-        if (!scene && dds.secure() && cfg.agent.handshake_timeout_s > 0) {
-          for (const auto& p : dds.peers_named(kServerParticipantName)) {
-            if (p.authenticated_after_s >= 0 || p.announced_s <= handshake_patience) continue;
-            spdlog::warn(
-                "{}: the server announced itself {:.1f} s ago and its authentication "
-                "handshake with this participant has not ended; leaving DDS and joining "
-                "again as a new participant",
-                label, p.announced_s);
-            return AgentApp::End::kHandshakeStall;
-          }
-        }
-        // Fast DDS 2.9 sometimes never matches one of 128 participants that
-        // start at once (docs/performance.md); a new participant is
-        // discovered afresh. No scene also means no mission to lose.
-        if (!scene && cfg.agent.rejoin_after_s > 0 && wall_seconds() - joined > patience) {
-          spdlog::warn("{}: no scene within {:.1f} s; leaving DDS and joining again as a new participant",
-                       label, patience);
-          return AgentApp::End::kNoScene;
+        JoinView view;
+        view.now_s = wall_seconds();
+        view.joined_s = joined;
+        view.has_scene = scene.has_value();
+        view.server_lost = server_lost;
+        view.last_state_s = last_sample_wall;
+        view.scene_s = scene_wall;
+        view.scene_writer_matched = scenes->matched() > 0;
+        view.scene_matched_since_s = scenes->matched_since();
+        for (const auto& b : brains)  // < 0: heard, or the server went silent since
+          if (b->unheard_since >= 0) view.unheard_since.emplace_back(b->id, b->unheard_since);
+        for (const auto& p : dds.peers_named(kServerParticipantName))
+          view.servers.push_back({p.prefix == server, p.announced_s, p.authenticated_after_s});
+        view.secure = dds.secure();
+        if (auto verdict = why_join_again(view, join_patience)) {
+          spdlog::warn("{}: {}", label, verdict->why);
+          return verdict->end;
         }
         // Woken at once when a scene asks for a (new) swarm-state reader or a
         // stop is requested (stop_waker), else after 250 ms: no polling, so

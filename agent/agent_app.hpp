@@ -10,6 +10,7 @@
 
 #include "agent/agent_config.hpp"
 #include "agent/comm_config.hpp"
+#include "agent/join_watch.hpp"
 #include "common/dds_config.hpp"
 #include "common/scenario.hpp"
 
@@ -42,29 +43,14 @@ class AgentApp {
   /// Joins DDS and checks that no other agent flies this drone (throws DuplicateAgent).
   explicit AgentApp(AgentAppConfig cfg);
   ~AgentApp();
-  enum class End {
-    kStopped,
-    kNoScene,
-    kRejoinRequested,
-    kOutlivedLease,
-    kUnheard,
-    kDeaf,
-    kHandshakeStall
-  };
+  using End = JoinEnd;
   /// Runs until stop_requested() or duration_s of wall time (<= 0: forever):
-  /// kStopped. kNoScene when no scene came within agent.rejoin_after_s of
-  /// joining, kRejoinRequested on take_rejoin_request() (SIGUSR1),
+  /// kStopped. kRejoinRequested on take_rejoin_request() (SIGUSR1),
   /// kOutlivedLease when this process was stopped or starved for longer than
   /// its DDS lease (dds.lease_duration_s), so its peers may have dropped it,
-  /// kUnheard when the server's samples have said for twice that lease that
-  /// it hears none of this process's answers, kDeaf when no swarm state came
-  /// for twice that lease while the server's scene writer stayed matched, or
-  /// while the last server has been silent and a new one announced, both for
-  /// twice that lease, and no scene came from the new one,
-  /// kHandshakeStall when, under DDS Security, the server announced itself
-  /// agent.handshake_timeout_s ago, no scene came and its authentication
-  /// handshake with this participant has not ended:
-  /// the caller should destroy this app and join again.
+  /// or the end that why_join_again() gives (kUnheard, kDeaf,
+  /// kHandshakeStall, kNoScene): the caller should destroy this app and join
+  /// again.
   End run(double duration_s);
   /// Whether this participant has heard the server's scene.
   bool heard_scene() const;

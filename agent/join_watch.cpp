@@ -1,0 +1,91 @@
+#include "agent/join_watch.hpp"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <algorithm>
+
+namespace ddswarm::agent {
+
+namespace {
+constexpr const char* kJoinAgain = "leaving DDS and joining again as a new participant";
+}
+
+double JoinPatience::deaf_s(bool secure) const {
+  return secure ? std::max(2 * lease_s, handshake_timeout_s) : 2 * lease_s;
+}
+
+std::optional<JoinVerdict> why_join_again(const JoinView& v, const JoinPatience& p) {
+  // Hearing, but not heard: the server's samples say for a while that it has
+  // no live agent for a drone this process answers for. Its reader lost this
+  // participant one-sidedly (the server was stopped longer than this agent's
+  // lease, or discovery dropped this participant's endpoints): a new
+  // participant is discovered afresh.
+  for (const auto& [id, since] : v.unheard_since) {
+    const double unheard = v.now_s - since;
+    if (unheard > 2 * p.lease_s)
+      return JoinVerdict{JoinEnd::kUnheard,
+                         fmt::format("the server's samples have marked drone {} agent-less for "
+                                     "{:.1f} s while this agent answered them: the server does "
+                                     "not hear this agent; {}",
+                                     id, unheard, kJoinAgain)};
+  }
+  // Deaf to a live server: its scene writer is still matched, yet no swarm
+  // state came for deaf_s. A live server publishes at least every 0.25 s
+  // (lockstep resends, a paused swarm), and one stopped longer than its lease
+  // is dropped with its writers, so this is a reader that lost or never
+  // matched the server's swarm-state writer. The count starts again when the
+  // server is matched again: one that was away longer than its lease comes
+  // back a moment before its states.
+  const double deaf_s = p.deaf_s(v.secure);
+  if (v.has_scene && v.scene_writer_matched) {
+    const double deaf = v.now_s - std::max({v.last_state_s, v.scene_s, v.scene_matched_since_s});
+    if (deaf > deaf_s)
+      return JoinVerdict{JoinEnd::kDeaf,
+                         fmt::format("no swarm state from the server for {:.1f} s while its "
+                                     "scene writer is still matched: this participant does not "
+                                     "hear the server; {}",
+                                     deaf, kJoinAgain)};
+  }
+  // Deaf to a new server: the old one went silent and another announced
+  // itself, both deaf_s ago, yet no scene came from it. What it sends this
+  // participant does not arrive, though its announcements do (over UDP): a
+  // server SIGKILLed while it held the lock of this agent's shared-memory
+  // port leaves every later message to that port lost. A new participant
+  // listens on new ports.
+  if (v.has_scene && v.server_lost) {
+    const double silent_for = v.now_s - v.last_state_s;
+    for (const auto& s : v.servers) {
+      if (s.current || std::min(s.announced_s, silent_for) <= deaf_s) continue;
+      return JoinVerdict{JoinEnd::kDeaf,
+                         fmt::format("a new server announced itself {:.1f} s ago, the last one "
+                                     "has been silent for {:.1f} s, and no scene came from the "
+                                     "new one: this participant does not hear it; {}",
+                                     s.announced_s, silent_for, kJoinAgain)};
+    }
+  }
+  // Under DDS Security a server that announced itself authenticates this
+  // participant within a second or two, at 16 drones too; its scene may take
+  // longer (the scene wait covers that). Fast DDS 2.9 sometimes leaves a
+  // handshake pending for good: a new participant starts every handshake
+  // afresh. Any server counts: a restarted one's predecessor may still be
+  // within its lease.
+  if (!v.has_scene && v.secure && p.handshake_wait_s > 0) {
+    for (const auto& s : v.servers) {
+      if (s.authenticated_after_s >= 0 || s.announced_s <= p.handshake_wait_s) continue;
+      return JoinVerdict{JoinEnd::kHandshakeStall,
+                         fmt::format("the server announced itself {:.1f} s ago and its "
+                                     "authentication handshake with this participant has not "
+                                     "ended; {}",
+                                     s.announced_s, kJoinAgain)};
+    }
+  }
+  // Fast DDS 2.9 sometimes never matches one of 128 participants that start
+  // at once (docs/performance.md); a new participant is discovered afresh.
+  // No scene also means no mission to lose.
+  if (!v.has_scene && p.scene_wait_s > 0 && v.now_s - v.joined_s > p.scene_wait_s)
+    return JoinVerdict{JoinEnd::kNoScene,
+                       fmt::format("no scene within {:.1f} s; {}", p.scene_wait_s, kJoinAgain)};
+  return std::nullopt;
+}
+
+}  // namespace ddswarm::agent
