@@ -15,11 +15,23 @@ std::string fmt(double v) {
   return os.str();
 }
 
+/// Six drones holding in lockstep at 12.5 s, D_int 4 m.
+SwarmStatus hovering() {
+  SwarmStatus s;
+  s.sim_time_s = 12.5;
+  s.real_time_factor = 1.0;
+  s.drones_online = s.drones_total = s.airborne = 6;
+  s.mode = "lockstep";
+  s.task_phase = "hold";
+  s.d_int_m = 4.0;
+  return s;
+}
+
 /// Records every command as one line, e.g. "move 0.4 1.2 0 30".
 class FakeCommander : public Commander {
  public:
   std::vector<std::string> calls;
-  SwarmStatus state{12.5, 1.0, 6, 6, 6, 0, "lockstep", "hold", 4.0};
+  SwarmStatus state = hovering();
   CommandResult answer{true, "6/6 acknowledged"};
   CommandResult task_answer{true, "6/6 acknowledged"};
   bool throw_on_command = false;
