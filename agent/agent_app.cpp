@@ -169,9 +169,10 @@ struct AgentApp::Impl {
   eprosima::fastrtps::rtps::SampleIdentity last_state;
   double scene_wall = -1e9;  // when the server's scene came (wall)
   bool server_lost = false;
-  // A lost server: the swarm-state reader is made anew (sync_states_reader),
-  // as docs/faults.md says. mu held.
+  // A lost server that is gone (lost_server_gone): the swarm-state reader is
+  // made anew (sync_states_reader), once per loss, as docs/faults.md says.
   bool renew_states = false;
+  bool states_renewed = false;  // for this loss
   std::uint64_t rejected = 0;  // samples refused before any drone saw them
   std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
   bool loss_logged = false;    // agent.state_loss said so in the log
@@ -306,12 +307,12 @@ struct AgentApp::Impl {
       renew = std::exchange(renew_states, false) && states != nullptr;
     }
     if (!want || (states && *want == states_delivery && !renew)) return;
-    // Renewed when the server is lost: a server SIGKILLed while it notified
-    // this reader left its lock held, and every later writer would wait 1 s
-    // on it per sample, a new server included. Deleting the reader takes that
-    // lock as well: where Fast DDS throws, this agent starts again
-    // (restart_on_dead_owner_lock) before a new server can come, here as on
-    // Fast DDS's own threads. A sound reader is made anew in a moment.
+    // Renewed when the lost server is gone (lost_server_gone): a server
+    // SIGKILLed while it notified this reader left its lock held, and every
+    // later writer would wait 1 s on it per sample, a new server included.
+    // Deleting the reader takes that lock as well: where Fast DDS throws, this
+    // agent starts again (restart_on_dead_owner_lock), here as on Fast DDS's
+    // own threads. A sound reader is made anew in a moment.
     if (states) {
       try {
         dds.remove(*states);
@@ -693,7 +694,7 @@ struct AgentApp::Impl {
         double silent = wall_seconds() - last_sample_wall;
         if (have_tick && !server_lost && silent > cfg.agent.server_timeout_s) {
           server_lost = true;
-          renew_states = true;
+          states_renewed = false;
           for (auto& b : brains) b->unheard_since = -1;  // counted again once it speaks
           spdlog::warn("{}: no server samples for {:.1f} s; holding commands until it returns",
                        label, silent);
@@ -712,6 +713,10 @@ struct AgentApp::Impl {
         for (const auto& p : dds.peers_named(kServerParticipantName))
           view.servers.push_back({p.prefix == server, p.announced_s, p.authenticated_after_s});
         view.secure = dds.secure();
+        if (!states_renewed && lost_server_gone(view)) {
+          renew_states = true;  // sync_states_reader, at the next turn
+          states_renewed = true;
+        }
         if (auto verdict = why_join_again(view, join_patience)) {
           spdlog::warn("{}: {}", label, verdict->why);
           return verdict->end;

@@ -14,6 +14,12 @@ double JoinPatience::deaf_s(bool secure) const {
   return secure ? std::max(2 * lease_s, handshake_timeout_s) : 2 * lease_s;
 }
 
+bool lost_server_gone(const JoinView& v) {
+  if (!v.server_lost) return false;
+  return !v.scene_writer_matched || std::any_of(v.servers.begin(), v.servers.end(),
+                                                [](const ServerPeer& s) { return !s.current; });
+}
+
 std::optional<JoinVerdict> why_join_again(const JoinView& v, const JoinPatience& p) {
   // Hearing, but not heard: the server's samples say for a while that it has
   // no live agent for a drone this process answers for. Its reader lost this

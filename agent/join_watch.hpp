@@ -67,6 +67,14 @@ struct JoinVerdict {
   std::string why;  ///< one log line, without the agent's label
 };
 
+/// Whether the lost server is gone, not merely slow: its scene writer is no
+/// longer matched (its lease ran out), or another server announced itself.
+/// Then the agent makes its swarm-state reader anew, since a server SIGKILLed
+/// while it notified that reader left the reader's lock held for good
+/// (docs/faults.md). A slow server keeps its readers: remaking 128 of them at
+/// every stall of a starved machine fed the stall (docs/performance.md).
+bool lost_server_gone(const JoinView& v);
+
 /// The first rule that ends this join, in the order docs/faults.md gives
 /// ("Why an agent joins again"):
 /// unheard, deaf to a live server, deaf to a new server, a stalled secure

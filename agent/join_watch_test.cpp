@@ -175,6 +175,22 @@ TEST(JoinWatch, NoSceneWithinTheWaitEndsTheJoinUnlessTheWaitIsOff) {
   EXPECT_FALSE(why_join_again(v, patience()));
 }
 
+// 128 processes in real time on 2 cores (2026-11-30): the server stalls for
+// a second now and then. Remaking every agent's swarm-state reader at each
+// stall fed it, and now and then a new reader met a Fast DDS assertion.
+TEST(JoinWatch, ASlowServerKeepsItsReadersAGoneOneDoesNot) {
+  JoinView v = flying();
+  v.last_state_s = 98.8;
+  EXPECT_FALSE(lost_server_gone(v)) << "not lost yet";
+  v.server_lost = true;
+  EXPECT_FALSE(lost_server_gone(v)) << "silent, its scene writer still matched: slow";
+  v.scene_writer_matched = false;  // its lease ran out
+  EXPECT_TRUE(lost_server_gone(v));
+  v.scene_writer_matched = true;  // SIGKILLed, and a new one announced within the lease
+  v.servers.push_back({false, 0.5, -1});
+  EXPECT_TRUE(lost_server_gone(v));
+}
+
 // The rules in the order docs/faults.md gives: the most specific first, so
 // the log names the cause a user can act on.
 TEST(JoinWatch, TheMostSpecificRuleSpeaks) {
