@@ -7,12 +7,13 @@
 // (real time) the age of the command each drone flies (DroneState.command_age_s
 // in every SwarmState) and how many commands were never applied.
 // Prints one line of key=value pairs.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -68,6 +69,10 @@ double percentile(const std::vector<long>& hist, double q) {
 
 }  // namespace
 
+/// s without a server's status before the probe joins again (then twice as
+/// long each time), as ddswarm-gs does through a discovery server.
+constexpr double kRejoinAfterS = 20.0;
+
 int main(int argc, char** argv) {
   return run_main("swarm_probe", [&]() -> int {
     CLI::App app{"swarm_probe: measure a running ddswarm swarm (bench/swarm_bench.sh)"};
@@ -89,25 +94,32 @@ int main(int argc, char** argv) {
       return app.exit(e) == 0 ? 0 : 2;
     }
     install_stop_signals();
-    Participant p(dds, "swarm_probe");
     std::mutex mu;
     msg::SimStatus status;
     bool have_status = false;
     double control_rate_hz = 0;
-    p.reader<msg::Scene>([&](const msg::Scene& s, const fdds::SampleInfo&) {
-      std::lock_guard<std::mutex> lock(mu);
-      control_rate_hz = s.control_rate_hz();
-    });
-    p.reader<msg::SimStatus>([&](const msg::SimStatus& s, const fdds::SampleInfo&) {
-      std::lock_guard<std::mutex> lock(mu);
-      status = s;
-      have_status = true;
-    });
     AgeStats ag;
     ag.last_applied.assign(drones, -1);
     ag.missed_by_drone.assign(drones, 0);
     std::atomic<bool> measuring{false};
-    if (ages) {
+    // A participant with its readers; made again while no server is heard
+    // through a discovery server, as the ground station does (a probe that
+    // joined a loaded 128-process swarm last once heard nothing for 240 s).
+    std::unique_ptr<Participant> participant;
+    auto join = [&] {
+      participant.reset();
+      participant = std::make_unique<Participant>(dds, "swarm_probe");
+      Participant& p = *participant;
+      p.reader<msg::Scene>([&](const msg::Scene& s, const fdds::SampleInfo&) {
+        std::lock_guard<std::mutex> lock(mu);
+        control_rate_hz = s.control_rate_hz();
+      });
+      p.reader<msg::SimStatus>([&](const msg::SimStatus& s, const fdds::SampleInfo&) {
+        std::lock_guard<std::mutex> lock(mu);
+        status = s;
+        have_status = true;
+      });
+      if (!ages) return;
       p.reader<msg::SwarmState>([&](const msg::SwarmState& s, const fdds::SampleInfo&) {
         if (!measuring) return;
         std::lock_guard<std::mutex> lock(mu);
@@ -147,16 +159,30 @@ int main(int argc, char** argv) {
         // the swarm late at once; a starved agent misses alone.
         if (tick_drones > 0 && 2 * tick_missing >= tick_drones) ag.missed_in_stalls += tick_missed;
       });
-    }
+    };
+    join();
     auto snapshot = [&] {
       std::lock_guard<std::mutex> lock(mu);
       return std::make_pair(have_status, status);
     };
     // 1. Every drone airborne.
     const double t0 = wall_seconds();
+    const bool via_discovery_server = dds.discovery == Discovery::kDiscoveryServer;
+    double joined = t0;
+    int joins = 0;
     while (!stop_requested()) {
       auto [ok, s] = snapshot();
       if (ok && s.airborne() >= drones) break;
+      const double waited = wall_seconds() - joined;
+      if (!ok && via_discovery_server && waited > rejoin_patience_s(kRejoinAfterS, joins)) {
+        std::fprintf(stderr,
+                     "swarm_probe: no server heard within %.0f s through the discovery server; "
+                     "joining again as a new participant\n",
+                     waited);
+        join();
+        joined = wall_seconds();
+        ++joins;
+      }
       if (wall_seconds() - t0 > timeout_s) {
         std::printf("probe ok=0 why=airborne_%d_of_%d_after_%.0fs\n", ok ? s.airborne() : 0, drones, timeout_s);
         return 1;
@@ -252,7 +278,7 @@ int main(int argc, char** argv) {
     line += fmt::format(" cpu_kernel={:.3f} cpu_kernel_top={}:{:.3f}", kernel, kernel_top_name,
                         kernel_top);
     std::printf("%s\n", line.c_str());
-    p.close();
+    participant->close();
     return 0;
   });
 }
