@@ -1,7 +1,8 @@
 #pragma once
-// Whether an agent's participant should leave DDS and join again, and why:
-// the rules of docs/faults.md as one pure function of what the agent's run
-// loop reads, free of DDS and clocks. AgentApp::run gathers the view under
+// Whether an agent's participant should leave DDS and join again, and why,
+// and whether a lost server is gone (its swarm-state reader is then made
+// anew): the rules of docs/faults.md as pure functions of what the agent's
+// run loop reads, free of DDS and clocks. AgentApp::run gathers the view under
 // its lock and applies the verdict; agent/main.cpp's join loop, with
 // RejoinPolicy, joins again.
 #include <optional>
