@@ -69,10 +69,6 @@ double percentile(const std::vector<long>& hist, double q) {
 
 }  // namespace
 
-/// s without a server's status before the probe joins again (then twice as
-/// long each time), as ddswarm-gs does through a discovery server.
-constexpr double kRejoinAfterS = 20.0;
-
 int main(int argc, char** argv) {
   return run_main("swarm_probe", [&]() -> int {
     CLI::App app{"swarm_probe: measure a running ddswarm swarm (bench/swarm_bench.sh)"};
@@ -174,7 +170,7 @@ int main(int argc, char** argv) {
       auto [ok, s] = snapshot();
       if (ok && s.airborne() >= drones) break;
       const double waited = wall_seconds() - joined;
-      if (!ok && via_discovery_server && waited > rejoin_patience_s(kRejoinAfterS, joins)) {
+      if (!ok && via_discovery_server && waited > rejoin_patience_s(kToolRejoinAfterS, joins)) {
         std::fprintf(stderr,
                      "swarm_probe: no server heard within %.0f s through the discovery server; "
                      "joining again as a new participant\n",

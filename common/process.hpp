@@ -62,6 +62,13 @@ void keep_joining(double duration_s, const std::function<bool(double left_s)>& j
 /// and at 128 processes fixed re-joins kept the swarm from ever coming up.
 double rejoin_patience_s(double base_s, int attempt);
 
+/// Through a discovery server: seconds without hearing the server after which
+/// a tool (ddswarm-gs, bench/swarm_probe) joins again as a new participant,
+/// the base of rejoin_patience_s (a healthy one hears it within 1-2 s; 6 s at
+/// a 128-process bring-up on 2026-11-21, 19-27 s on 2026-11-27's slower
+/// machine).
+constexpr double kToolRejoinAfterS = 20.0;
+
 /// Notices that this process was stopped (SIGSTOP, Ctrl-Z, a debugger) or
 /// starved for longer than the DDS lease it announces. Its peers may then
 /// have dropped it while it still holds them, and Fast DDS 2.9 does not

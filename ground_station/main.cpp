@@ -30,12 +30,6 @@ using namespace ddswarm::gs;
 
 namespace {
 
-/// Through a discovery server: seconds without hearing the server after which
-/// a ground station joins again as a new participant, twice as long at each
-/// try (a healthy one hears it within 1-2 s; 6 s at a 128-process bring-up on
-/// 2026-11-21, 19-27 s on 2026-11-27's slower machine).
-constexpr double kRejoinAfterS = 20.0;
-
 int report(const CommandResult& r) {
   std::printf("%s\n", r.message.c_str());
   return r.ok ? 0 : 1;
@@ -287,7 +281,7 @@ int main(int argc, char** argv) {
     // Give discovery a moment: the server's status is transient-local.
     // Status needs only the clock (a replayed recording has no server to command).
     // Through a discovery server, a participant that hears no server within
-    // kRejoinAfterS (then twice as long at each try) joins again as a new
+    // kToolRejoinAfterS (then twice as long at each try) joins again as a new
     // one: under a 128-process bring-up Fast DDS 2.9's discovery server
     // sometimes drops a participant's endpoints for good, and a ground
     // station's as well as an agent's.
@@ -299,7 +293,7 @@ int main(int argc, char** argv) {
       commander.reset();  // the old participant leaves before the new one joins
       commander = std::make_unique<DdsCommander>(file.gs, file.dds);
       const double slice =
-          via_discovery_server ? std::min(left, rejoin_patience_s(kRejoinAfterS, joins++)) : left;
+          via_discovery_server ? std::min(left, rejoin_patience_s(kToolRejoinAfterS, joins++)) : left;
       ready = (*status || (*task && attach)) ? commander->wait_for_status(slice) : commander->wait_for_server(slice);
       if (ready || stop_requested() || !via_discovery_server || left - slice < 1.0) return false;
       std::fprintf(stderr,
