@@ -249,10 +249,18 @@ int main(int argc, char** argv) {
       // And ground stations patient enough for their own re-join through it
       // (ground_station/main.cpp: after 20 s without a server), which also
       // carries them over a restart of the discovery server (docs/faults.md).
+      // And no shared-memory transport, unless the scenario names it: a
+      // sender opening a peer's port waits a third of dds.shm_health_check_s
+      // (3.3 s) whenever the port's idle listener was just checked, with
+      // every send of its participant held. In a 128-process bring-up the
+      // server stalled 10-20 s that way and lost most agents; over UDP (the
+      // swarm state still by data-sharing) it never did (docs/dds.md).
       const YAML::Node root = YamlDocument::load_file(scenario).root();
       std::map<std::string, YAML::Node> for_ds;
       if (!(root["dds"] && root["dds"]["lease_duration_s"]))
         for_ds["dds.lease_duration_s"] = YAML::Node(kDiscoveryServerLeaseS);
+      if (!(root["dds"] && root["dds"]["shm_transport"]))
+        for_ds["dds.shm_transport"] = YAML::Node(false);
       if (!(root["ground_station"] && root["ground_station"]["discovery_timeout_s"]))
         for_ds["ground_station.discovery_timeout_s"] = YAML::Node(kDiscoveryServerGsTimeoutS);
       if (!for_ds.empty()) {

@@ -2,7 +2,9 @@
 # Issue 8: the launcher runs a Fast DDS discovery server for the swarm. Forced
 # on for six drones, every child is pointed at it, the lockstep task
 # completes, and the server process is gone when the launcher is; with auto,
-# six drones stay on simple discovery.
+# six drones stay on simple discovery. A swarm with a discovery server leaves
+# out the shared-memory transport (its port opens stalled 128-process
+# bring-ups) and keeps data-sharing, unless the scenario names the transport.
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/config/thesis_course.yaml"
 
@@ -36,4 +38,38 @@ start launch2 "$BIN/ddswarm-launch" "$scenario" --domain "$DOMAIN" --drones 6 --
 wait_pid "$PID_launch2" 90; rc=$?
 [ $rc -eq 0 ] || fail "launcher (auto) exit $rc"
 grep -q "discovery server on" "$WORK/launch2.log" && fail "auto started a discovery server for 6 drones"
+
+# transport_maps LAUNCH_PID: "T D" per server and agent under the launcher,
+# once each maps a data-sharing segment (its participants are up): T regions
+# of the shared-memory transport (fastrtps_*), D of data-sharing.
+transport_maps() {
+  local procs p
+  for _ in $(seq 150); do
+    procs=$(pgrep -P "$1" -f "ddswarm-(sim|agent) ")
+    if [ "$(echo "$procs" | wc -w)" -eq 4 ]; then
+      local ready=1
+      for p in $procs; do grep -q "/dev/shm/fast_datasharing_" "/proc/$p/maps" 2>/dev/null || ready=0; done
+      if [ $ready -eq 1 ]; then
+        for p in $procs; do
+          echo "$(grep -c "/dev/shm/fastrtps_" "/proc/$p/maps") $(grep -c "/dev/shm/fast_datasharing_" "/proc/$p/maps")"
+        done
+        return 0
+      fi
+    fi
+    sleep 0.1
+  done
+  return 1
+}
+start launch3 "$BIN/ddswarm-launch" "$scenario" --domain "$DOMAIN" --drones 3 --mode realtime \
+  --discovery-server on --duration 30 --log-dir "$WORK/logs3"
+maps=$(transport_maps "$PID_launch3") || fail "the server and 3 agents did not all map data-sharing within 15 s"
+grep -q "dds.shm_transport: false" "$WORK/launch3.log" || fail "the launcher did not say it left out the transport"
+echo "$maps" | awk '$1 != 0 { exit 1 }' || fail "with a discovery server, a process maps the shared-memory transport: $maps"
+kill -INT "$PID_launch3"; wait_pid "$PID_launch3" 30 || fail "launcher 3 did not stop"
+# Named by the scenario (here by --set), the transport stays.
+start launch4 "$BIN/ddswarm-launch" "$scenario" --domain "$DOMAIN" --drones 3 --mode realtime \
+  --discovery-server on --duration 30 --log-dir "$WORK/logs4" --set dds.shm_transport=true
+maps=$(transport_maps "$PID_launch4") || fail "the server and 3 agents did not all map data-sharing within 15 s (transport named)"
+echo "$maps" | awk '$1 == 0 { exit 1 }' || fail "dds.shm_transport=true named, yet a process maps no shared-memory transport: $maps"
+kill -INT "$PID_launch4"; wait_pid "$PID_launch4" 30 || fail "launcher 4 did not stop"
 echo PASS
