@@ -252,9 +252,10 @@ int main(int argc, char** argv) {
       // And no shared-memory transport, unless the scenario names it: a
       // sender opening a peer's port waits a third of dds.shm_health_check_s
       // (3.3 s) whenever the port's idle listener was just checked, with
-      // every send of its participant held. In a 128-process bring-up the
-      // server stalled 10-20 s that way and lost most agents; over UDP (the
-      // swarm state still by data-sharing) it never did (docs/dds.md).
+      // every send of its participant held. In 128-process bring-ups the
+      // server stalled 10-20 s that way and lost up to 119 of 128 agents;
+      // over UDP (the swarm state still by data-sharing) it never did
+      // (docs/dds.md).
       const YAML::Node root = YamlDocument::load_file(scenario).root();
       std::map<std::string, YAML::Node> for_ds;
       if (!(root["dds"] && root["dds"]["lease_duration_s"]))
