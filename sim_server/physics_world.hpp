@@ -14,7 +14,7 @@
 
 class btDefaultCollisionConfiguration;
 class btCollisionDispatcher;
-class btDbvtBroadphase;
+struct btDbvtBroadphase;  // Bullet declares it a struct (clang: -Wmismatched-tags)
 class btSequentialImpulseConstraintSolver;
 class btDiscreteDynamicsWorld;
 class btCollisionObject;
