@@ -258,12 +258,13 @@ int main(int argc, char** argv) {
       // (docs/dds.md).
       const YAML::Node root = YamlDocument::load_file(scenario).root();
       std::map<std::string, YAML::Node> for_ds;
-      if (!(root["dds"] && root["dds"]["lease_duration_s"]))
-        for_ds["dds.lease_duration_s"] = YAML::Node(kDiscoveryServerLeaseS);
-      if (!(root["dds"] && root["dds"]["shm_transport"]))
-        for_ds["dds.shm_transport"] = YAML::Node(false);
-      if (!(root["ground_station"] && root["ground_station"]["discovery_timeout_s"]))
-        for_ds["ground_station.discovery_timeout_s"] = YAML::Node(kDiscoveryServerGsTimeoutS);
+      auto unless_named = [&](const char* section, const char* key, const YAML::Node& value) {
+        if (!(root[section] && root[section][key]))
+          for_ds[fmt::format("{}.{}", section, key)] = value;
+      };
+      unless_named("dds", "lease_duration_s", YAML::Node(kDiscoveryServerLeaseS));
+      unless_named("dds", "shm_transport", YAML::Node(false));
+      unless_named("ground_station", "discovery_timeout_s", YAML::Node(kDiscoveryServerGsTimeoutS));
       if (!for_ds.empty()) {
         std::string why;
         for (const auto& [key, value] : for_ds)
