@@ -32,6 +32,10 @@
 namespace ddswarm {
 namespace {
 
+/// A partition no ddswarm writer publishes in: a reader's own subscriber
+/// goes there before the reader is deleted (Participant::leave_writers).
+constexpr const char* kLeavingPartition = "ddswarm/leaving";
+
 using eprosima::fastdds::rtps::SharedMemTransportDescriptor;
 using eprosima::fastdds::rtps::UDPv4TransportDescriptor;
 using eprosima::fastrtps::rtps::IPLocator;
@@ -423,6 +427,42 @@ fdds::Subscriber* Participant::subscriber_for(const std::string& partition) {
   return s;
 }
 
+fdds::Subscriber* Participant::own_subscriber(const std::string& partition) {
+  fdds::SubscriberQos qos = fdds::SUBSCRIBER_QOS_DEFAULT;
+  if (!partition.empty()) qos.partition().push_back(partition.c_str());
+  auto* s = participant_->create_subscriber(qos);
+  if (!s) throw DdsError("cannot create DDS subscriber for partition '" + partition + "'");
+  std::lock_guard<std::mutex> lock(mu_);
+  own_subscribers_.insert(s);
+  return s;
+}
+
+bool Participant::bounded(fdds::Topic* topic) const {
+  const fdds::TypeSupport ts = participant_->find_type(topic->get_type_name());
+  return !ts.empty() && ts->is_bounded();
+}
+
+void Participant::leave_writers(fdds::Subscriber* s) {
+  fdds::SubscriberQos qos = s->get_qos();
+  qos.partition().clear();
+  qos.partition().push_back(kLeavingPartition);
+  if (s->set_qos(qos) != ReturnCode_t::RETCODE_OK)
+    spdlog::debug(
+        "dds: a reader's subscriber did not leave its writers' partition before its deletion");
+}
+
+void Participant::delete_reader(fdds::DataReader* r) {
+  auto* s = const_cast<fdds::Subscriber*>(r->get_subscriber());
+  bool own = false;
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    own = own_subscribers_.erase(s) > 0;
+  }
+  if (own) leave_writers(s);
+  s->delete_datareader(r);
+  if (own) participant_->delete_subscriber(s);
+}
+
 std::string Participant::refused_hint(const std::string& partition) const {
   if (!secure_) return "";
   return " (DDS Security: does role " + role_ + "'s grant allow it" +
@@ -430,11 +470,20 @@ std::string Participant::refused_hint(const std::string& partition) const {
 }
 
 void Participant::close() {
-  if (participant_ && !closed_) participant_->delete_contained_entities();
+  if (participant_ && !closed_) {
+    std::set<fdds::Subscriber*> own;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      own = own_subscribers_;
+    }
+    for (auto* s : own) leave_writers(s);
+    participant_->delete_contained_entities();
+  }
   closed_ = true;
   std::lock_guard<std::mutex> lock(mu_);
   partition_publishers_.clear();
   partition_subscribers_.clear();
+  own_subscribers_.clear();
 }
 
 Participant::~Participant() {

@@ -19,6 +19,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -231,6 +232,10 @@ class Participant {
       // state's readers are transient-local instead (config/dds_profiles.xml).
       if (!shared_memory_ || delivery == Delivery::kArchive || never_shares(q))
         q.data_sharing().off();
+      // A reader that may take samples by data-sharing gets a subscriber of
+      // its own, so that it alone can leave every writer before it is
+      // deleted (delete_reader()).
+      if (q.data_sharing().kind() != fdds::OFF && bounded(topic)) sub = own_subscriber(partition);
       r = sub->create_datareader(topic, q, listener.get());
     }
     if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));
@@ -256,8 +261,7 @@ class Participant {
   template <class T>
   void remove(Reader<T>& r) {
     if (closed_ || !r.raw()) return;
-    fdds::DataReader* raw_reader = r.raw();
-    const_cast<fdds::Subscriber*>(raw_reader->get_subscriber())->delete_datareader(raw_reader);
+    delete_reader(r.raw());
     r.attach(nullptr);
   }
 
@@ -279,6 +283,21 @@ class Participant {
  private:
   fdds::Publisher* publisher_for(const std::string& partition);
   fdds::Subscriber* subscriber_for(const std::string& partition);
+  /// A new subscriber in partition, for one reader that may take samples by
+  /// data-sharing; deleted with it.
+  fdds::Subscriber* own_subscriber(const std::string& partition);
+  /// Whether topic's type has a bound, as data-sharing needs.
+  bool bounded(fdds::Topic* topic) const;
+  /// Deletes a reader, and the subscriber it has to itself, having first
+  /// taken that subscriber out of every writer's partition (leave_writers()).
+  void delete_reader(fdds::DataReader* r);
+  /// Moves a reader's own subscriber to a partition no writer uses: Fast DDS
+  /// unmatches every writer at once, on this thread, while the reader lives.
+  /// Debian's Fast DDS 2.9.1 spins for ever in a data-sharing reader's thread
+  /// that holds a sample when the reader is marked dead (its backport of
+  /// CVE-2023-39534), and deleting the reader then waits for that thread for
+  /// ever; a reader with no writer's pool left holds no sample (docs/dds.md).
+  static void leave_writers(fdds::Subscriber* s);
   /// No VOLATILE reader by data-sharing (reader(), profile_never_shares()).
   static bool never_shares(const fdds::DataReaderQos& q) {
     return q.durability().kind == fdds::VOLATILE_DURABILITY_QOS;
@@ -313,6 +332,7 @@ class Participant {
   fdds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, fdds::Publisher*> partition_publishers_;    // guarded by mu_
   std::map<std::string, fdds::Subscriber*> partition_subscribers_;  // guarded by mu_
+  std::set<fdds::Subscriber*> own_subscribers_;                     // guarded by mu_
   std::mutex mu_;
   std::map<std::string, fdds::Topic*> topics_;
   std::vector<std::unique_ptr<fdds::DataReaderListener>> listeners_;

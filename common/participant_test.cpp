@@ -210,6 +210,92 @@ TEST(Participant, ArchiveReaderKeepsEverySampleThroughAStall) {
   tools.close();
 }
 
+// Debian's Fast DDS 2.9.1 spins for ever in a data-sharing reader's thread
+// that holds a sample when the reader is marked dead, and deleting the reader
+// waits for that thread for ever (docs/dds.md). An agent renews its
+// swarm-state reader while the server writes, and every process deletes its
+// readers as it exits: both must come back. The writer writes a state every
+// 0.1 ms all the while (faster than any swarm ticks), so the reader's thread
+// is often busy with one. Still, the race is rare (6 hangs in about 435
+// loaded runs of the test above, none in 240 deletions here without the
+// mend), so each round also checks what rules it out: the reader had left
+// the writer before it was deleted.
+enum class Leave { kRemoveTheReader, kCloseTheParticipant };
+
+void leave_a_busy_writer(Leave how, int times) {
+  DdsConfig cfg;
+  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  Participant server(cfg, "participant_test writer");
+  auto w = server.writer<msg::SwarmState>();
+  std::atomic<bool> writing{true};
+  std::atomic<std::uint64_t> written{0};
+  std::thread writer([&] {
+    msg::SwarmState s;
+    while (writing.load()) {
+      s.tick(written.load() + 1);
+      if (w.write(s)) ++written;
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+  });
+  struct StopWriting {
+    std::atomic<bool>& writing;
+    std::thread& writer;
+    ~StopWriting() {
+      writing = false;
+      if (writer.joinable()) writer.join();
+    }
+  } stop_writing{writing, writer};
+  for (int k = 0; k < times; ++k) {
+    std::atomic<int> got{0};  // outlives the participant's callbacks
+    Participant agent(cfg, "participant_test data-sharing reader");
+    if (!agent.shared_memory()) GTEST_SKIP() << "no data-sharing here (the TSan build)";
+    auto& r = agent.reader<msg::SwarmState>(
+        [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got; });
+    ASSERT_TRUE(within(10, [&] { return r.matched() == 1; }));
+    const std::uint64_t before = written.load();
+    ASSERT_TRUE(within(10, [&] { return written.load() > before + 100; })) << "the writer stopped";
+    // On a thread of its own, so that a hang fails the test instead of
+    // reaching ctest's timeout with nothing said.
+    std::atomic<bool> done{false};
+    std::thread leaver([&] {
+      if (how == Leave::kRemoveTheReader)
+        agent.remove(r);
+      else
+        agent.close();
+      done = true;
+    });
+    if (!within(10, [&] { return done.load(); })) {
+      std::fprintf(stderr,
+                   "FAILED: %s a data-sharing reader of a busy writer did not return within 10 s "
+                   "(round %d; Fast DDS's data-sharing thread spins on a dead reader's sample); "
+                   "ending the test process\n",
+                   how == Leave::kRemoveTheReader ? "removing" : "closing the participant of",
+                   k + 1);
+      std::fflush(nullptr);
+      std::_Exit(1);
+    }
+    leaver.join();
+    // What keeps the thread from spinning: the reader left the writer (and
+    // Fast DDS took the writer's pool from that thread) while it lived.
+    EXPECT_EQ(r.matched(), 0) << "round " << k + 1
+                              << ": the reader was deleted still matched to the writer";
+    const int after = got.load();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_EQ(got.load(), after) << "a handler ran after its reader left";
+    agent.close();
+  }
+  const std::uint64_t then = written.load();
+  EXPECT_TRUE(within(10, [&] { return written.load() > then; })) << "the writer stopped";
+}
+
+TEST(Participant, RemovingADataSharingReaderOfABusyWriterReturns) {
+  leave_a_busy_writer(Leave::kRemoveTheReader, 10);
+}
+
+TEST(Participant, ClosingWithADataSharingReaderOfABusyWriterReturns) {
+  leave_a_busy_writer(Leave::kCloseTheParticipant, 10);
+}
+
 TEST(Participant, OnlyPerTickStreamsMayBeReadBestEffort) {
   DdsConfig cfg;
   cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
