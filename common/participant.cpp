@@ -414,24 +414,24 @@ fdds::Publisher* Participant::publisher_for(const std::string& partition) {
   return p;
 }
 
-fdds::Subscriber* Participant::subscriber_for(const std::string& partition) {
-  if (partition.empty()) return subscriber_;
-  std::lock_guard<std::mutex> lock(mu_);
-  auto& s = partition_subscribers_[partition];
-  if (!s) {
-    fdds::SubscriberQos qos = fdds::SUBSCRIBER_QOS_DEFAULT;
-    qos.partition().push_back(partition.c_str());
-    s = participant_->create_subscriber(qos);
-    if (!s) throw DdsError("cannot create DDS subscriber for partition " + partition);
-  }
-  return s;
-}
-
-fdds::Subscriber* Participant::own_subscriber(const std::string& partition) {
+fdds::Subscriber* Participant::new_subscriber(const std::string& partition) {
   fdds::SubscriberQos qos = fdds::SUBSCRIBER_QOS_DEFAULT;
   if (!partition.empty()) qos.partition().push_back(partition.c_str());
   auto* s = participant_->create_subscriber(qos);
   if (!s) throw DdsError("cannot create DDS subscriber for partition '" + partition + "'");
+  return s;
+}
+
+fdds::Subscriber* Participant::subscriber_for(const std::string& partition) {
+  if (partition.empty()) return subscriber_;
+  std::lock_guard<std::mutex> lock(mu_);
+  auto& s = partition_subscribers_[partition];
+  if (!s) s = new_subscriber(partition);
+  return s;
+}
+
+fdds::Subscriber* Participant::own_subscriber(const std::string& partition) {
+  auto* s = new_subscriber(partition);
   std::lock_guard<std::mutex> lock(mu_);
   own_subscribers_.insert(s);
   return s;

@@ -283,6 +283,8 @@ class Participant {
  private:
   fdds::Publisher* publisher_for(const std::string& partition);
   fdds::Subscriber* subscriber_for(const std::string& partition);
+  /// A new subscriber in partition (none: the default partition); throws DdsError.
+  fdds::Subscriber* new_subscriber(const std::string& partition);
   /// A new subscriber in partition, for one reader that may take samples by
   /// data-sharing; deleted with it.
   fdds::Subscriber* own_subscriber(const std::string& partition);
