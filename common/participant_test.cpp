@@ -27,6 +27,9 @@
 namespace ddswarm {
 namespace {
 
+/// A random DDS domain in 20-79 for one test, apart from most others'.
+int random_test_domain() { return 20 + static_cast<int>(random_instance() % 60); }
+
 eprosima::fastrtps::rtps::GuidPrefix_t join_and_leave(const DdsConfig& cfg) {
   Participant p(cfg, "participant_test");
   return p.raw()->guid().guidPrefix;
@@ -34,7 +37,7 @@ eprosima::fastrtps::rtps::GuidPrefix_t join_and_leave(const DdsConfig& cfg) {
 
 TEST(Participant, EveryJoinOfAProcessHasItsOwnGuid) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   cfg.participant_id = 117;  // as an agent of a 128-drone swarm: the same id at every join
   const auto first = join_and_leave(cfg);
   const auto second = join_and_leave(cfg);
@@ -79,7 +82,7 @@ bool within(double seconds, Pred done) {
 TEST(Participant, ReliableWriterServesBestEffortAndReliableReaders) {
   std::atomic<int> got_latest{0}, got_all{0};  // outlive the participants' callbacks
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test writer");
   Participant agent(cfg, "participant_test best-effort reader");
   Participant recorder(cfg, "participant_test reliable reader");
@@ -119,7 +122,7 @@ int commands_through_a_stall(std::uint32_t server_port_queue, std::uint32_t host
                              int burst) {
   std::atomic<int> got{0};  // outlives the participants' callbacks
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   DdsConfig server_cfg = cfg;
   server_cfg.shm_port_queue = server_port_queue;
   DdsConfig host_cfg = cfg;
@@ -176,7 +179,7 @@ TEST(Participant, ArchiveReaderKeepsEverySampleThroughAStall) {
   constexpr int kSamples = 40;
   std::atomic<int> got_archive{0}, got_profile{0}, out_of_order{0};
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test writer");
   Participant tools(cfg, "participant_test stalled readers");
   auto w = server.writer<msg::SwarmState>();
@@ -224,7 +227,7 @@ enum class Leave { kRemoveTheReader, kCloseTheParticipant };
 
 void leave_a_busy_writer(Leave how, int times) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test writer");
   auto w = server.writer<msg::SwarmState>();
   std::atomic<bool> writing{true};
@@ -298,7 +301,7 @@ TEST(Participant, ClosingWithADataSharingReaderOfABusyWriterReturns) {
 
 TEST(Participant, OnlyPerTickStreamsMayBeReadBestEffort) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant p(cfg, "participant_test");
   EXPECT_THROW(p.reader<msg::Scene>([](const msg::Scene&, const fdds::SampleInfo&) {}, std::nullopt, Delivery::kLatest),
                DdsError);
@@ -326,7 +329,7 @@ std::size_t data_sharing_pools_of(const Participant& p) {
 
 TEST(Participant, SwarmStateUsesSharedMemoryOnlyWhenAllowed) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   cfg.shared_memory = false;
   Participant udp_only(cfg, "participant_test");
   EXPECT_FALSE(udp_only.shared_memory());
@@ -348,7 +351,7 @@ TEST(Participant, SwarmStateUsesSharedMemoryOnlyWhenAllowed) {
 // killed agent's lease: its period outlasts the longest lease ddswarm gives.
 TEST(Participant, TheSwarmStateHeartbeatOutlastsEveryLease) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant p(cfg, "participant_test");
   auto w = p.writer<msg::SwarmState>();
   const auto hb = w.raw()->get_qos().reliable_writer_qos().times.heartbeatPeriod;
@@ -364,7 +367,7 @@ TEST(Participant, TheSwarmStateHeartbeatOutlastsEveryLease) {
 // new server"): by name, oldest first, gone once it leaves.
 TEST(Participant, PeersAreKnownByNameFromDiscoveryAlone) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant agent(cfg, "participant_test agent");
   EXPECT_TRUE(agent.peers_named("participant_test server").empty());
   {
@@ -392,7 +395,7 @@ TEST(Participant, PeersAreKnownByNameFromDiscoveryAlone) {
 // from none.
 TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant agent(cfg, "participant_test reader");
   auto& r = agent.reader<msg::Scene>([](const msg::Scene&, const fdds::SampleInfo&) {});
   EXPECT_LT(r.matched_since(), 0);
@@ -423,7 +426,7 @@ TEST(Participant, AReaderKnowsSinceWhenItsWritersAreMatched) {
 // DdsConfig::announce_to_tools_only, which needs separate processes.
 TEST(Participant, AParticipantIdInUseOnThisHostIsSeenTaken) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   cfg.shared_memory = false;
   cfg.participant_id = kAgentParticipantIdBase + 1;
   EXPECT_FALSE(participant_id_taken_here(cfg.domain_id, cfg.participant_id));
@@ -446,7 +449,7 @@ TEST(Participant, WithoutTheShmTransportTheSwarmStateStillComesByDataSharing) {
   // SIGKILLed one leaves its file) and away from automatic ids.
   cfg.participant_id = -1;
   for (int tries = 0; tries < 10 && cfg.participant_id < 0; ++tries) {
-    cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+    cfg.domain_id = random_test_domain();
     cfg.participant_id = participant_id_clear_of_shm(
         cfg.domain_id, 199, "/dev/shm", 100 + static_cast<int>(random_instance() % 100));
   }
@@ -497,7 +500,7 @@ class ThrowingType : public fdds::TopicDataType {
 // docs/faults.md).
 TEST(Participant, AWriteThatThrowsIsCountedAndTheWriterGoesOn) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant p(cfg, "participant_test");
   fdds::TypeSupport ts(new ThrowingType());
   ASSERT_EQ(ts.register_type(p.raw()), ReturnCode_t::RETCODE_OK);
@@ -525,7 +528,7 @@ TEST(Participant, AWriteThatThrowsIsCountedAndTheWriterGoesOn) {
 TEST(Participant, AHandlerThatThrowsDropsItsSampleAndTheReaderGoesOn) {
   std::atomic<int> handled{0};  // outlives the participants' callbacks
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test writer");
   Participant agent(cfg, "participant_test reader");
   auto w = server.writer<msg::SimStatus>();
@@ -572,7 +575,7 @@ ReaderKinds state_reader_kinds(const DdsConfig& c) {
 // data-sharing off; run in a process of its own.
 int volatile_profile_reader_shares_nothing() {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   std::ifstream in(cfg.profiles_file);
   std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string tl = "<kind>TRANSIENT_LOCAL</kind>";
@@ -599,7 +602,7 @@ TEST(Participant, NoVolatileReaderUsesDataSharingWhateverTheProfileSays) {
   EXPECT_EXIT(std::exit(volatile_profile_reader_shares_nothing()), ::testing::ExitedWithCode(0),
               "");
   DdsConfig cfg;  // the shipped profile: transient-local, by data-sharing on the host
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   const ReaderKinds k = state_reader_kinds(cfg);
   EXPECT_EQ(k.durability, fdds::TRANSIENT_LOCAL_DURABILITY_QOS);
   if (k.shared_memory) {  // never in TSan builds
@@ -616,7 +619,7 @@ TEST(Participant, ReadersJoiningABusyDataSharingWriterLive) {
   std::atomic<bool> stop{false};
   std::atomic<std::uint64_t> written{0};
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test busy writer");
   Participant agent(cfg, "participant_test joining readers");
   auto w = server.writer<msg::SwarmState>();
@@ -656,7 +659,7 @@ TEST(Participant, ReadersJoiningABusyDataSharingWriterLive) {
 // each new state as it comes.
 TEST(Participant, AJoiningStateReaderGetsTheNewestStateOnly) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test writer");
   Participant first(cfg, "participant_test first reader");
   auto w = server.writer<msg::SwarmState>();
@@ -719,7 +722,7 @@ TEST(EndProcess, WithEveryParticipantGoneExitsWithItsCodeAndLosesNoOutput) {
   EXPECT_EXIT(
       {
         DdsConfig cfg;
-        cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+        cfg.domain_id = random_test_domain();
         { Participant p(cfg, "participant_test leaving"); }
         FILE* f = std::fopen((dir + "/stdio.txt").c_str(), "w");
         std::fputs("the stdio line", f);  // left open: only a flush writes it
@@ -743,7 +746,7 @@ TEST(EndProcess, WithEveryParticipantGoneExitsWithItsCodeAndLosesNoOutput) {
 // deletes it and tells its peers: end_process returns the code.
 TEST(EndProcess, WithAParticipantOpenLeavesTheExitToFastDds) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   Participant p(cfg, "participant_test staying");
   EXPECT_EQ(end_process(5), 5);
 }
