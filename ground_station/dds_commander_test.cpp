@@ -19,6 +19,11 @@
 namespace ddswarm::gs {
 namespace {
 
+/// A random DDS domain in 80-99 for one test. ctest runs unit tests two at a
+/// time; participant_test draws from 20-79 and shm_clean_test from 170-219,
+/// so these never share a domain with them (multi-process tests run alone).
+int random_test_domain() { return 80 + static_cast<int>(random_instance() % 20); }
+
 /// Stands in for a server and six agents in one participant: heartbeats for
 /// every drone, a SimStatus listing only `server_hears` of them.
 class FakeSwarm {
@@ -74,7 +79,7 @@ class FakeSwarm {
 
 TEST(DdsCommander, WaitsForTheServerToHearEveryAgentNotOnlyItself) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   FakeSwarm swarm(cfg);
   swarm.server_hears(5);  // drone 0 matched the ground station, not yet the server
   DdsCommander gs(GroundStationConfig{}, cfg);
@@ -115,7 +120,7 @@ TEST(ClimbOver, EitherWordPastTheClimbEndsIt) {
 // not after its timeout (a minute per run before).
 TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   DdsCommander gs(GroundStationConfig{}, cfg);  // no swarm at all
   std::atomic<int> asked{0};
   const double t0 = wall_seconds();
@@ -130,7 +135,7 @@ TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
 // starts it again, up to kRunStarts times; any other failure is its result.
 TEST(Experiment, ARunWhoseSwarmNeverCameUpStartsAgain) {
   DdsConfig cfg;
-  cfg.domain_id = 20 + static_cast<int>(random_instance() % 60);
+  cfg.domain_id = random_test_domain();
   DdsCommander gs(GroundStationConfig{}, cfg);  // no swarm at all
   const TaskOutcome o = fly_task(
       gs, 6, TaskConfig{}, nullptr, [] { return false; }, 0.3);
