@@ -223,9 +223,9 @@ if ! skip floor && ! skip ceiling; then
     done
   done
   echo
-  echo "== the ceiling of lockstep: the floor with a lockstep server's physics between ticks (the scenario's N drones hovering, their controllers, Bullet and sensors), median of $FLOOR_REPEATS round(s); plain lockstep can tick no faster, and no lockstep on $(nproc) cores faster than with the physics hidden =="
-  echo "| N | physics (Hz) | floor ticks/s | floor with physics ticks/s | its ratio to the floor (plain lockstep's ceiling) | floor CPU per tick (µs) | physics CPU per tick (µs) | physics hidden: $(nproc) cores ÷ both (ticks/s) | its ratio to the floor |"
-  echo "|---|---|---|---|---|---|---|---|---|"
+  echo "== the ceiling of lockstep: the floor with a lockstep server's physics between ticks (the scenario's N drones hovering, their controllers, Bullet and sensors), median of $FLOOR_REPEATS round(s); plain lockstep can tick no faster, and no lockstep on $(nproc) cores faster than with the physics hidden; a lockstep that keeps the cores as busy as the floor does, costs nothing beyond the floor and the physics and hides the physics, ticks at floor CPU ÷ (floor CPU + physics CPU) of the floor =="
+  echo "| N | physics (Hz) | floor ticks/s | floor with physics ticks/s | its ratio to the floor (plain lockstep's ceiling) | floor CPU per tick (µs) | physics CPU per tick (µs) | physics hidden: $(nproc) cores ÷ both (ticks/s) | its ratio to the floor | cores the floor keeps busy | physics hidden at the floor's use of the cores: ratio to the floor |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
   $PY - "$FLOOR_CSV" "$CEIL_CSV" "$(nproc)" "$SIZES" "${LS_PHYSICS:-$PHYS_HZ}" <<'EOF'
 import csv, statistics, sys
 floor = [r for r in csv.DictReader(open(sys.argv[1])) if r["ok"] == "1"]
@@ -239,6 +239,7 @@ for n in map(int, sys.argv[4].split()):
         [r for r in floor if int(r["n"]) == n]
     f_tps = med([float(r["ticks_per_s"]) for r in f])
     f_us = med([float(r["busy_cores"]) / float(r["ticks_per_s"]) * 1e6 for r in f])
+    f_busy = med([float(r["busy_cores"]) for r in f])
     for hz in map(float, sys.argv[5].split()):
         c = [r for r in ceil if int(r["n"]) == n and float(r["physics_hz"]) == hz]
         c_tps = med([float(r["ticks_per_s"]) for r in c])
@@ -246,7 +247,8 @@ for n in map(int, sys.argv[4].split()):
         hidden = cores * 1e6 / (f_us + p_us)
         print(f"| {n} | {hz:.0f} | {cell(f_tps, '{:.0f}')} | {cell(c_tps, '{:.0f}')} | "
               f"{cell(c_tps / f_tps, '{:.2f}')} | {cell(f_us, '{:.0f}')} | {cell(p_us, '{:.0f}')} | "
-              f"{cell(hidden, '{:.0f}')} | {cell(hidden / f_tps, '{:.2f}')} |")
+              f"{cell(hidden, '{:.0f}')} | {cell(hidden / f_tps, '{:.2f}')} | "
+              f"{cell(f_busy, '{:.2f}')} | {cell(f_us / (f_us + p_us), '{:.2f}')} |")
 EOF
 fi
 
