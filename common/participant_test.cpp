@@ -215,41 +215,54 @@ TEST(Participant, ArchiveReaderKeepsEverySampleThroughAStall) {
   tools.close();
 }
 
+/// Writes a 6-drone swarm state every 0.1 ms on a thread of its own, from
+/// construction to destruction: 10,000 states a second, over three times the
+/// fastest ddswarm publishes (2,783 ticks/s, 6 drones in lockstep).
+class BusyStateWriter {
+ public:
+  explicit BusyStateWriter(Participant& p)
+      : w_(p.writer<msg::SwarmState>()), thread_([this] { run(); }) {}
+  ~BusyStateWriter() {
+    stop_ = true;
+    thread_.join();
+  }
+  /// States written so far.
+  std::uint64_t written() const { return written_.load(); }
+
+ private:
+  void run() {
+    msg::SwarmState s;
+    s.drones().resize(6);
+    auto next = std::chrono::steady_clock::now();
+    for (std::uint64_t k = 1; !stop_.load(); ++k) {
+      s.tick(k);
+      if (w_.write(s)) ++written_;
+      next += std::chrono::microseconds(100);
+      std::this_thread::sleep_until(next);
+    }
+  }
+
+  Writer<msg::SwarmState> w_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> written_{0};
+  std::thread thread_;  // last: it starts once the rest is made
+};
+
 // Debian's Fast DDS 2.9.1 spins for ever in a data-sharing reader's thread
 // that holds a sample when the reader is marked dead, and deleting the reader
 // waits for that thread for ever (docs/dds.md). An agent renews its
 // swarm-state reader while the server writes, and every process deletes its
-// readers as it exits: both must come back. The writer writes a state every
-// 0.1 ms all the while (faster than any swarm ticks), so the reader's thread
-// is often busy with one. Still, the race is rare (6 hangs in about 435
-// loaded runs of the test above, none in 240 deletions here without the
-// mend), so each round also checks what rules it out: the reader had left
-// the writer before it was deleted.
+// readers as it exits: both must come back. A BusyStateWriter writes all the
+// while, so the reader's thread is often busy with a state. Still, the race is rare (6 hangs in
+// about 435 loaded runs of the test above, none in 240 deletions here without the mend), so each
+// round also checks what rules it out: the reader had left the writer before it was deleted.
 enum class Leave { kRemoveTheReader, kCloseTheParticipant };
 
 void leave_a_busy_writer(Leave how, int times) {
   DdsConfig cfg;
   cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test writer");
-  auto w = server.writer<msg::SwarmState>();
-  std::atomic<bool> writing{true};
-  std::atomic<std::uint64_t> written{0};
-  std::thread writer([&] {
-    msg::SwarmState s;
-    while (writing.load()) {
-      s.tick(written.load() + 1);
-      if (w.write(s)) ++written;
-      std::this_thread::sleep_for(std::chrono::microseconds(100));
-    }
-  });
-  struct StopWriting {
-    std::atomic<bool>& writing;
-    std::thread& writer;
-    ~StopWriting() {
-      writing = false;
-      if (writer.joinable()) writer.join();
-    }
-  } stop_writing{writing, writer};
+  BusyStateWriter writer(server);
   for (int k = 0; k < times; ++k) {
     std::atomic<int> got{0};  // outlives the participant's callbacks
     Participant agent(cfg, "participant_test data-sharing reader");
@@ -257,8 +270,9 @@ void leave_a_busy_writer(Leave how, int times) {
     auto& r = agent.reader<msg::SwarmState>(
         [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got; });
     ASSERT_TRUE(within(10, [&] { return r.matched() == 1; }));
-    const std::uint64_t before = written.load();
-    ASSERT_TRUE(within(10, [&] { return written.load() > before + 100; })) << "the writer stopped";
+    const std::uint64_t before = writer.written();
+    ASSERT_TRUE(within(10, [&] { return writer.written() > before + 100; }))
+        << "the writer stopped";
     // On a thread of its own, so that a hang fails the test instead of
     // reaching ctest's timeout with nothing said.
     std::atomic<bool> done{false};
@@ -289,8 +303,8 @@ void leave_a_busy_writer(Leave how, int times) {
     EXPECT_EQ(got.load(), after) << "a handler ran after its reader left";
     agent.close();
   }
-  const std::uint64_t then = written.load();
-  EXPECT_TRUE(within(10, [&] { return written.load() > then; })) << "the writer stopped";
+  const std::uint64_t then = writer.written();
+  EXPECT_TRUE(within(10, [&] { return writer.written() > then; })) << "the writer stopped";
 }
 
 TEST(Participant, RemovingADataSharingReaderOfABusyWriterReturns) {
@@ -613,45 +627,31 @@ TEST(Participant, NoVolatileReaderUsesDataSharingWhateverTheProfileSays) {
 }
 
 // Readers made and removed under a writer that writes throughout must all
-// live, and each must hear it. The writer is paced at 10,000 states a
-// second, over three times the fastest ddswarm publishes (2,783 ticks/s, 6
-// drones in lockstep): unpaced, near 250,000 a second, Fast DDS 2.9.1 itself
-// crashes about one joining reader in 1,000 (docs/dds.md).
+// live, and each must hear it. The writer is paced (BusyStateWriter):
+// unpaced, near 250,000 a second, Fast DDS 2.9.1 itself crashes about one
+// joining reader in 1,000 (docs/dds.md).
 TEST(Participant, ReadersJoiningABusyDataSharingWriterLive) {
-  std::atomic<bool> stop{false};
-  std::atomic<std::uint64_t> written{0};
   DdsConfig cfg;
   cfg.domain_id = random_test_domain();
   Participant server(cfg, "participant_test busy writer");
   Participant agent(cfg, "participant_test joining readers");
-  auto w = server.writer<msg::SwarmState>();
-  std::thread writer([&] {
-    msg::SwarmState s;
-    s.drones().resize(6);
-    auto next = std::chrono::steady_clock::now();
-    for (std::uint64_t k = 1; !stop.load(); ++k) {
-      s.tick(k);
-      w.write(s);
-      written = k;
-      next += std::chrono::microseconds(100);
-      std::this_thread::sleep_until(next);
+  {
+    BusyStateWriter writer(server);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(8);
+    int joins = 0;
+    while (std::chrono::steady_clock::now() < end) {
+      std::atomic<int> got{0};
+      auto& r = agent.reader<msg::SwarmState>(
+          [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got; }, std::nullopt,
+          Delivery::kLatest);
+      ASSERT_TRUE(within(10, [&] { return got.load() > 0; }))
+          << "join " << joins << " heard nothing";
+      agent.remove(r);
+      ++joins;
     }
-  });
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(8);
-  int joins = 0;
-  while (std::chrono::steady_clock::now() < end) {
-    std::atomic<int> got{0};
-    auto& r = agent.reader<msg::SwarmState>(
-        [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got; }, std::nullopt,
-        Delivery::kLatest);
-    ASSERT_TRUE(within(10, [&] { return got.load() > 0; })) << "join " << joins << " heard nothing";
-    agent.remove(r);
-    ++joins;
+    std::printf("%d readers joined a writer that wrote %llu states\n", joins,
+                static_cast<unsigned long long>(writer.written()));
   }
-  stop = true;
-  writer.join();
-  std::printf("%d readers joined a writer that wrote %llu states\n", joins,
-              static_cast<unsigned long long>(written.load()));
   server.close();
   agent.close();
 }
