@@ -16,6 +16,8 @@
 #include <utility>
 
 #include "agent/comm_model.hpp"
+#include "agent/law_frame.hpp"
+#include "agent/law_registry.hpp"
 #include "agent/mission_fsm.hpp"
 #include "agent/peer_source.hpp"
 #include "agent/swarm_law.hpp"
@@ -27,11 +29,24 @@
 
 namespace ddswarm::agent {
 
+namespace {
+/// Every override names drones of the scenario.
+void check_overrides(const AgentAppConfig& c) {
+  for (std::size_t k = 0; k < c.agent.overrides.size(); ++k)
+    for (int id : c.agent.overrides[k].ids)
+      if (id >= c.scenario.drones)
+        throw FieldError("agent.overrides[" + std::to_string(k) + "].ids", c.agent.overrides[k].ids_text,
+                         "drone " + std::to_string(id) + " is not in the scenario (scenario.drones = " +
+                             std::to_string(c.scenario.drones) + ")");
+}
+}  // namespace
+
 void AgentAppConfig::validate() const {
   scenario.validate();
   agent.validate();
   comm.validate();
   dds.validate();
+  check_overrides(*this);
   if (drone_ids.empty()) throw FieldError("--id/--ids", "", "no drone to fly");
   for (int id : drone_ids)
     if (id < 0 || id >= scenario.drones)
@@ -51,6 +66,7 @@ AgentAppConfig load_agent_config(const std::string& path) {
     c.agent.validate();
     c.comm.validate();
     c.dds.validate();
+    check_overrides(c);
   });
   return c;
 }
@@ -115,6 +131,17 @@ struct DroneBrain {
   std::vector<Eigen::Vector3d> ranged;
   std::vector<float> ranges, angles;
   std::vector<std::uint8_t> hits;
+  // The swarm law this drone flies (agent.law, or its override), built with
+  // the mission; what it is shown each tick; and its faults.
+  const LawConfig* law_cfg = nullptr;
+  std::unique_ptr<law::SwarmLaw> law;
+  std::vector<law::Peer> law_peers;
+  std::vector<law::Ray> law_rays;
+  double yaw_rate_rad_s = 0;      // the law's, this tick
+  std::string law_fault;          // the first fault; empty while the law is sound
+  std::uint64_t law_faults = 0;   // ticks the law failed (one, since it is not asked again)
+  double law_fault_at_s = -1;     // sim time of the fault
+  bool fault_landing = false;     // the fault's hover ended and the landing was ordered
   // The last answer sent. A tick that comes again (lockstep: the server
   // published it twice, a sample was lost) gets the same answer again, not
   // a second run of the mission machine and the law.
@@ -134,6 +161,7 @@ struct DroneBrain {
 
   void reset_mission() {
     fsm.reset();
+    law.reset();
     modelled.reset();
     peers = &truth;
     seen_missions.clear();
@@ -401,6 +429,22 @@ struct AgentApp::Impl {
 
   void start_brain(DroneBrain& b) {
     b.fsm = std::make_unique<MissionFsm>(b.id, cfg.agent, *scene);
+    b.law_cfg = &cfg.agent.law_for(b.id);
+    law::LawContext ctx;
+    ctx.drone_id = b.id;
+    ctx.num_drones = cfg.scenario.drones;
+    ctx.inter_distance_m = cfg.agent.inter_distance_m;
+    ctx.max_speed_mps = cfg.agent.max_speed_mps;
+    ctx.control_period_s = 1.0 / scene_control_rate_hz;
+    try {
+      b.law = make_law(*b.law_cfg, ctx, law::Rng(law_seed(scene_seed, b.id)), cfg.agent);
+    } catch (const std::exception& e) {
+      // Checked when the config was read; a law can still fail on what only
+      // the scene says (its control rate).
+      on_law_fault(b, std::string("could not be built: ") + e.what(), 0.0);
+    }
+    if (b.law_cfg->type != LawType::kThesis && &b == brains.front().get())
+      spdlog::info("{}: flying the {} law", label, b.law_cfg->name());
     if (cfg.comm.ideal()) return;
     const double tick_s = 1.0 / scene_control_rate_hz;
     const double ticks_per_beacon = scene_control_rate_hz / cfg.comm.beacon_rate_hz;
@@ -414,6 +458,101 @@ struct AgentApp::Impl {
     if (&b == brains.front().get())
       spdlog::info("{}: peers from {} through the communication model", label,
                    cfg.comm.source == PeerSourceType::kBeacons ? "beacons" : "truth");
+  }
+
+  /// Hover this long (s, sim) after a law faults, then land.
+  static constexpr double kLawFaultHoverS = 2.0;
+
+  void on_law_fault(DroneBrain& b, const std::string& why, double t) {
+    ++b.law_faults;
+    if (!b.law_fault.empty()) return;
+    b.law_fault = one_line(why);
+    b.law_fault_at_s = t;
+    spdlog::error("drone {}: the {} law faulted at sim time {:.2f} s: {}; the drone hovers {:.0f} s, "
+                  "then lands, and takes no mission command",
+                  b.id, b.law_cfg ? b.law_cfg->name() : "thesis", t, b.law_fault,
+                  kLawFaultHoverS);
+  }
+
+  /// A faulted law's drone: hovers where it is, then lands through its
+  /// mission machine; the law is not asked again.
+  void fly_fault(DroneBrain& b, LawInput& in, MissionOutput& out, const Observation& obs) {
+    in.swarm_enabled = false;
+    if (out.phase == Phase::kIdle || out.phase == Phase::kLanding) return;
+    if (obs.sim_time_s - b.law_fault_at_s < kLawFaultHoverS) {
+      in.mission_velocity.setZero();
+      out.busy = true;
+      return;
+    }
+    if (!b.fault_landing) {
+      b.fault_landing = true;
+      MissionCommand land;
+      land.type = MissionType::kLand;
+      land.target = b.id;
+      land.seq = 1;
+      land.issuer = "law-fault";
+      b.fsm->apply(land, obs);
+      out = b.fsm->step(obs);
+      set_mission(in, out);
+      in.swarm_enabled = false;
+    }
+  }
+
+  /// What drone b's law is shown: its own state as it knows it, the peers
+  /// its source delivers (in.peers_world, in the source's order), the scan.
+  law::Observation observe(DroneBrain& b, const LawInput& in, const MissionOutput& out,
+                           const Observation& obs, const msg::SwarmState& s) {
+    law::Observation o;
+    o.drone_id = b.id;
+    o.tick = s.tick();
+    o.sim_time_s = s.sim_time_s();
+    o.dt_s = control_period_s;
+    o.p_world = in.p_world;
+    o.v_world = obs.v_world;
+    o.q_world_body = in.q_world_body;
+    b.law_peers.clear();
+    auto add = [&](std::size_t k, const PeerObservation& h) {
+      const Eigen::Vector3d p = k < in.peers_world.size() ? in.peers_world[k] : h.p_world;
+      b.law_peers.push_back({h.id, p, h.v_world, s.sim_time_s() - h.stamp_s});
+    };
+    if (b.modelled) {
+      const auto heard = b.modelled->heard(s.sim_time_s());
+      for (std::size_t k = 0; k < heard.size(); ++k) add(k, heard[k]);
+    } else {
+      std::size_t k = 0;
+      for (const auto& r : roster)
+        if (r.id != b.id) add(k++, r);
+    }
+    b.law_rays.clear();
+    for (std::size_t k = 0; k < in.ray_range_m.size(); ++k)
+      b.law_rays.push_back({in.ray_range_m[k], in.ray_hit[k] != 0, in.ray_yaw_body_rad[k], 0.0});
+    o.peers = b.law_peers;
+    o.rays = b.law_rays;
+    o.phase = static_cast<law::Phase>(out.phase);
+    o.mission_velocity = in.mission_velocity;
+    if (out.phase == Phase::kTask || out.phase == Phase::kSwarm)
+      o.goal_world = Eigen::Vector3d(scene->goal_xy.x(), scene->goal_xy.y(), out.altitude_target_m);
+    o.inter_distance_m = in.inter_distance_m;
+    o.altitude_target_m = in.altitude_target_m;
+    o.max_speed_mps = cfg.agent.max_speed_mps;
+    return o;
+  }
+
+  /// This tick's command: the drone's law inside the framework (step_law).
+  /// A law that throws or answers a non-finite number faults here, and its
+  /// drone starts to hover this very tick.
+  LawTerms command(DroneBrain& b, LawInput& in, MissionOutput& out, const Observation& obs,
+                   const msg::SwarmState& s) {
+    law::SwarmLaw* l = b.law_fault.empty() ? b.law.get() : nullptr;
+    LawStep r = l && in.swarm_enabled ? step_law(l, observe(b, in, out, obs, s), in, cfg.agent)
+                                      : step_law(nullptr, {}, in, cfg.agent);
+    if (!r.fault.empty()) {
+      on_law_fault(b, r.fault, obs.sim_time_s);
+      fly_fault(b, in, out, obs);
+      r = step_law(nullptr, {}, in, cfg.agent);
+    }
+    b.yaw_rate_rad_s = r.yaw_rate_rad_s;
+    return r.terms;
   }
 
   void publish_status() {
@@ -434,6 +573,9 @@ struct AgentApp::Impl {
         s.inter_distance_m(b->fsm ? b->fsm->inter_distance_m() : cfg.agent.inter_distance_m);
         s.rejected_samples(static_cast<std::uint32_t>(rejected + b->rejected + malformed_samples().load()));
         s.commands_sent(static_cast<std::uint32_t>(b->sent));
+        s.law(cfg.agent.law_for(b->id).name().substr(0, 32));
+        s.law_faults(static_cast<std::uint32_t>(b->law_faults));
+        s.law_fault(b->law_fault.substr(0, 255));
         out.push_back(std::move(s));
       }
     }
@@ -490,7 +632,9 @@ struct AgentApp::Impl {
         ++rejected;
         continue;
       }
-      roster.push_back({d.drone_id(), from_msg(d.position()), d.sim_time_s()});
+      PeerObservation o{d.drone_id(), from_msg(d.position()), d.sim_time_s()};
+      if (finite(d.velocity())) o.v_world = from_msg(d.velocity());
+      roster.push_back(o);
     }
     for (const auto& b : brains) answer(*b, s);
   }
@@ -552,6 +696,12 @@ struct AgentApp::Impl {
         continue;
       }
       if (!b.fsm->addressed_to_me(c)) continue;
+      if (!b.law_fault.empty()) {
+        MissionAck a{static_cast<std::uint16_t>(id), m.seq(), false, "swarm law faulted: " + b.law_fault,
+                     b.fsm->phase(), s.tick()};
+        w_ack.write(to_msg(a, m.issuer_instance()));
+        continue;
+      }
       if (joining && m.apply_tick() < s.tick()) {
         MissionAck a = b.fsm->resume(c, static_cast<double>(m.apply_tick()) * control_period_s, obs);
         if (a.accepted) b.accepted(m);
@@ -621,14 +771,17 @@ struct AgentApp::Impl {
     in.ray_hit = b.hits;
     in.ray_yaw_body_rad = b.angles;
     set_mission(in, out);
-    Eigen::Vector3d v = out.motors_on ? control_velocity(in, cfg.agent) : Eigen::Vector3d::Zero();
+    if (!b.law_fault.empty()) fly_fault(b, in, out, obs);
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    if (out.motors_on) v = command(b, in, out, obs, s).velocity;
+    if (!b.law_fault.empty()) out.phase = Phase::kFailsafe;
 
     msg::VelocityCommand cmd;
     cmd.drone_id(static_cast<std::uint16_t>(id));
     cmd.tick(s.tick());
     cmd.sim_time_s(s.sim_time_s());
     cmd.velocity(to_msg(v));
-    cmd.yaw_rate_rad_s(0.0);  // heading held: the sensors keep their layout (thesis)
+    cmd.yaw_rate_rad_s(b.yaw_rate_rad_s);  // the thesis law holds the heading: the sensors keep their layout
     cmd.motors_on(out.motors_on);
     cmd.phase(static_cast<std::uint8_t>(out.phase));
     cmd.busy(out.busy);

@@ -1,7 +1,12 @@
 #include "agent/agent_config.hpp"
 
 #include <cmath>
+#include <set>
+#include <stdexcept>
 #include <string>
+
+#include "agent/law_registry.hpp"
+#include "common/id_ranges.hpp"
 
 namespace ddswarm::agent {
 namespace {
@@ -99,7 +104,63 @@ void SensorFunctionConfig::validate() const {
                      "the last point must have f = 0 (its S is the function's range)");
 }
 
+const char* to_string(LawType t) {
+  switch (t) {
+    case LawType::kThesis: return "thesis";
+    case LawType::kReynolds: return "reynolds";
+    case LawType::kOlfatiSaber: return "olfati_saber";
+    case LawType::kVasarhelyi: return "vasarhelyi";
+    case LawType::kPlugin: return "plugin";
+  }
+  return "?";
+}
+
+void LawConfig::validate() const {
+  if (type != LawType::kPlugin && !library.empty())
+    throw FieldError(path + ".library", library, "only used with type: plugin");
+  check_range(path + ".fault_after_s", fault_after_s, 0.0, 3600.0);
+  if (fault == Fault::kNone && fault_after_s > 0)
+    throw FieldError(path + ".fault_after_s", to_text(fault_after_s), "needs fault: nan or throw");
+  law::LawContext ctx;
+  ctx.drone_id = 0;
+  ctx.num_drones = 1;
+  try {
+    make_law(*this, ctx, law::Rng(0), AgentConfig{});
+  } catch (const law::ParamError& e) {
+    throw FieldError(e.field(), e.value(), e.reason());
+  } catch (const std::exception& e) {
+    throw FieldError(path + (type == LawType::kPlugin ? ".library" : ".type"),
+                     type == LawType::kPlugin ? library : to_string(type),
+                     std::string("the law could not be built: ") + e.what());
+  }
+}
+
+std::string LawConfig::name() const {
+  if (type != LawType::kPlugin) return to_string(type);
+  const auto slash = library.find_last_of('/');
+  return "plugin " + (slash == std::string::npos ? library : library.substr(slash + 1));
+}
+
+const LawConfig& AgentConfig::law_for(int id) const {
+  for (auto it = overrides.rbegin(); it != overrides.rend(); ++it)
+    for (int i : it->ids)
+      if (i == id) return it->law;
+  return law;
+}
+
 void AgentConfig::validate() const {
+  law.validate();
+  std::set<int> taken;
+  for (std::size_t k = 0; k < overrides.size(); ++k) {
+    const auto& o = overrides[k];
+    const std::string at = "agent.overrides[" + std::to_string(k) + "]";
+    if (o.ids.empty()) throw FieldError(at + ".ids", o.ids_text, "names no drone");
+    for (int id : o.ids)
+      if (!taken.insert(id).second)
+        throw FieldError(at + ".ids", o.ids_text,
+                         "drone " + std::to_string(id) + " is in an earlier override too");
+    o.law.validate();
+  }
   check_range("agent.goal_gain", goal_gain, 1e-6, 5.0);
   check_positive("agent.inter_distance_m", inter_distance_m);
   activation.validate();
@@ -158,7 +219,54 @@ void load(YamlSection s, SensorFunctionConfig& c) {
   s.finish();
 }
 
+void load(YamlSection s, LawConfig& c) {
+  c.path = s.path();
+  s.get_enum("type", c.type,
+             {{"thesis", LawType::kThesis},
+              {"reynolds", LawType::kReynolds},
+              {"olfati_saber", LawType::kOlfatiSaber},
+              {"vasarhelyi", LawType::kVasarhelyi},
+              {"plugin", LawType::kPlugin}});
+  s.get("library", c.library);
+  s.get_enum("fault", c.fault,
+             {{"none", LawConfig::Fault::kNone},
+              {"nan", LawConfig::Fault::kNaN},
+              {"throw", LawConfig::Fault::kThrow}});
+  s.get("fault_after_s", c.fault_after_s);
+  YamlSection p = s.child("params");
+  if (p.node().IsMap()) {
+    for (auto it = p.node().begin(); it != p.node().end(); ++it) {
+      const std::string key = it->first.Scalar();
+      if (!it->second.IsScalar())
+        p.fail(it->second, key, "(not a scalar)", "a law parameter must be a number, true/false or a word");
+      std::string value;
+      p.get(key, value);
+      c.params[key] = value;
+    }
+  }
+  p.finish();
+  s.finish();
+}
+
 void load(YamlSection s, AgentConfig& c) {
+  load(s.child("law"), c.law);
+  auto overrides = s.children("overrides");
+  for (std::size_t k = 0; k < overrides.size(); ++k) {
+    auto& o = overrides[k];
+    LawOverride lo;
+    o.get("ids", lo.ids_text);
+    try {
+      // The scenario's drone count is checked by the agent, which knows it.
+      lo.ids = parse_id_ranges(lo.ids_text, 1 << 16);
+    } catch (const std::invalid_argument& e) {
+      std::string why = e.what();
+      if (auto colon = why.find(": "); colon != std::string::npos) why = why.substr(colon + 2);
+      throw FieldError(o.path() + ".ids", lo.ids_text, why);
+    }
+    load(o.child("law"), lo.law);
+    o.finish();
+    c.overrides.push_back(std::move(lo));
+  }
   s.get("inter_distance_m", c.inter_distance_m);
   load(s.child("activation"), c.activation);
   load(s.child("sensor_function"), c.sensor_function);

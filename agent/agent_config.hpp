@@ -6,6 +6,8 @@
 // field, e.g. `agent.inter_distance_m = -4: must be > 0`. The shapes of the
 // functions these parameters describe are documented in agent/swarm_law.hpp.
 #include <Eigen/Core>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "common/yaml_section.hpp"
@@ -59,7 +61,46 @@ struct SensorFunctionConfig {
   void validate() const;  ///< throws FieldError("agent.sensor_function.…")
 };
 
+/// The built-in swarm laws (docs/laws.md).
+enum class LawType { kThesis, kReynolds, kOlfatiSaber, kVasarhelyi, kPlugin };
+
+/// Which law a drone flies: YAML `agent.law` (or an override's `law`).
+struct LawConfig {
+  LawType type = LawType::kThesis;  ///< thesis | reynolds | olfati_saber | vasarhelyi | plugin
+  /// plugin: the law's shared library (DDSWARM_LAW_PLUGIN); a relative path
+  /// is taken from the working directory.
+  std::string library;
+  /// `params`: name -> scalar as written; each law reads and checks its own
+  /// (thesis takes none: the agent section's activation and sensor_function
+  /// configure it).
+  std::map<std::string, std::string> params;
+  std::string path = "agent.law";  ///< where it was read, for error messages
+  /// Fault injection, for testing what a swarm does when a law breaks: from
+  /// fault_after_s (s, sim; 0 = never) on, the law throws (`throw`) or
+  /// answers NaN (`nan`) instead of its command. [0, 3600].
+  enum class Fault { kNone, kNaN, kThrow } fault = Fault::kNone;
+  double fault_after_s = 0;
+
+  void validate() const;  ///< builds the law once: throws FieldError("agent.law.params.…")
+  /// "thesis", "reynolds", ... or "plugin libmylaw.so" (the library's file name).
+  std::string name() const;
+};
+
+/// A law for some drones: YAML `agent.overrides: [{ids: 3-5, law: {...}}]`.
+struct LawOverride {
+  std::string ids_text;  ///< as written, e.g. "3-5,7"
+  std::vector<int> ids;  ///< parsed; each < scenario.drones (checked by the agent)
+  LawConfig law;
+};
+
+const char* to_string(LawType t);
+
 struct AgentConfig {
+  LawConfig law;                       ///< every drone's law unless an override names it
+  std::vector<LawOverride> overrides;  ///< later entries win; an id in two entries is refused
+  /// The law drone id flies.
+  const LawConfig& law_for(int id) const;
+
   double inter_distance_m = 4.0;  ///< m, D_int, wanted drone-to-drone distance; > 0
   ActivationConfig activation;
   SensorFunctionConfig sensor_function;
@@ -103,5 +144,6 @@ struct AgentConfig {
 void load(YamlSection s, AgentConfig& c);
 void load(YamlSection s, ActivationConfig& c);
 void load(YamlSection s, SensorFunctionConfig& c);
+void load(YamlSection s, LawConfig& c);
 
 }  // namespace ddswarm::agent

@@ -194,3 +194,86 @@ TEST(AgentConfig, ShippedScenariosLoad) {
     EXPECT_EQ(c.activation.neighbours, std::string(name) == "swarm_field.yaml" ? 6 : 0);
   }
 }
+
+TEST(AgentConfig, TheThesisLawIsTheDefaultForEveryDrone) {
+  AgentConfig c = loaded("agent: {}\n");
+  EXPECT_EQ(c.law.type, LawType::kThesis);
+  EXPECT_TRUE(c.overrides.empty());
+  EXPECT_EQ(&c.law_for(0), &c.law);
+  EXPECT_EQ(&c.law_for(511), &c.law);
+}
+
+TEST(AgentConfig, OverridesGiveDronesTheirOwnLaw) {
+  AgentConfig c = loaded(R"(
+agent:
+  law: {type: reynolds}
+  overrides:
+    - ids: 3-5
+      law: {type: vasarhelyi, params: {v_flock_mps: 1.5}}
+    - ids: 7
+      law: {type: olfati_saber}
+)");
+  EXPECT_EQ(c.law_for(0).type, LawType::kReynolds);
+  EXPECT_EQ(c.law_for(2).type, LawType::kReynolds);
+  for (int id : {3, 4, 5}) EXPECT_EQ(c.law_for(id).type, LawType::kVasarhelyi) << id;
+  EXPECT_EQ(c.law_for(3).params.at("v_flock_mps"), "1.5");
+  EXPECT_EQ(c.law_for(6).type, LawType::kReynolds);
+  EXPECT_EQ(c.law_for(7).type, LawType::kOlfatiSaber);
+}
+
+TEST(AgentConfig, ALawRefusesWhatItDoesNotTakeNamingFileLineAndField) {
+  const std::string unknown =
+      error_of("agent:\n  law:\n    type: reynolds\n    params:\n      cohesion_gian: 1\n");
+  EXPECT_EQ(unknown.rfind("s.yaml:5: agent.law.params.cohesion_gian = 1: unknown parameter (this law takes ", 0), 0u)
+      << unknown;
+  EXPECT_NE(unknown.find("cohesion_gain"), std::string::npos) << unknown;
+  EXPECT_EQ(error_of("agent:\n  law: {type: thesis, params: {gain: 2}}\n"),
+            "s.yaml:2: agent.law.params.gain = 2: unknown parameter (this law takes none)");
+  EXPECT_EQ(error_of("agent:\n  law: {type: boids}\n"),
+            "s.yaml:2: agent.law.type = boids: must be one of olfati_saber|plugin|reynolds|thesis|vasarhelyi");
+  EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, params: {cohesion_gain: fast}}\n"),
+            "s.yaml:2: agent.law.params.cohesion_gain = fast: must be a finite number");
+  EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, params: {cohesion_gain: [1, 2]}}\n")
+                .rfind("s.yaml:2: agent.law.params.cohesion_gain = (not a scalar): ", 0),
+            0u);
+  EXPECT_EQ(error_of("agent:\n  law: {type: vasarhelyi, params: nope}\n"),
+            "s.yaml:2: agent.law.params: must be a mapping of key: value");
+}
+
+TEST(AgentConfig, AnOverrideIsCheckedLikeTheSwarmsLaw) {
+  EXPECT_EQ(error_of("agent:\n  overrides:\n    - ids: 2\n      law:\n        type: olfati_saber\n"
+                     "        params: {epsilon: -1}\n")
+                .rfind("s.yaml:6: agent.overrides[0].law.params.epsilon = -1: must be in [", 0),
+            0u);
+  EXPECT_EQ(error_of("agent:\n  overrides:\n    - ids: 5-3\n      law: {type: reynolds}\n"),
+            "s.yaml:3: agent.overrides[0].ids = 5-3: range 5-3 runs backwards");
+  EXPECT_EQ(error_of("agent:\n  overrides:\n    - {ids: 1-3, law: {type: reynolds}}\n"
+                     "    - {ids: 3, law: {type: vasarhelyi}}\n"),
+            "s.yaml:4: agent.overrides[1].ids = 3: drone 3 is in an earlier override too");
+  EXPECT_EQ(error_of("agent:\n  overrides:\n    - {ids: 1, lwa: {type: reynolds}}\n"),
+            "s.yaml:3: agent.overrides[0].lwa: unknown key");
+}
+
+TEST(AgentConfig, AnInjectedLawFaultNeedsAKind) {
+  EXPECT_EQ(error_of("agent:\n  law: {fault_after_s: 3}\n"),
+            "s.yaml:2: agent.law.fault_after_s = 3: needs fault: nan or throw");
+  EXPECT_EQ(loaded("agent:\n  law: {fault: throw, fault_after_s: 3}\n").law.fault, LawConfig::Fault::kThrow);
+}
+
+TEST(AgentConfig, APluginLibraryThatCannotBeFlownIsRefusedWithItsReason) {
+  EXPECT_EQ(error_of("agent:\n  law: {type: plugin}\n"),
+            "s.yaml:2: agent.law.library = \"\": a plug-in law needs the path of its library");
+  EXPECT_EQ(error_of("agent:\n  law: {type: plugin, library: /nonexistent/libx.so}\n"),
+            "s.yaml:2: agent.law.library = /nonexistent/libx.so: no such file");
+  // A file that is no shared library, and a library that is no plug-in.
+  EXPECT_EQ(error_of("agent:\n  law: {type: plugin, library: /etc/hostname}\n")
+                .rfind("s.yaml:2: agent.law.library = /etc/hostname: cannot be loaded: ", 0),
+            0u);
+  const std::string libm = "/lib/x86_64-linux-gnu/libm.so.6";
+  EXPECT_EQ(error_of("agent:\n  law: {type: plugin, library: " + libm + "}\n"),
+            "s.yaml:2: agent.law.library = " + libm +
+                ": is not a ddswarm law plug-in: it exports no ddswarm_law_api_version or "
+                "ddswarm_law_factory (export the law with DDSWARM_LAW_PLUGIN, docs/laws.md)");
+  EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, library: x.so}\n"),
+            "s.yaml:2: agent.law.library = x.so: only used with type: plugin");
+}

@@ -2,6 +2,7 @@
 // Where an agent's knowledge of its peers comes from. The law sees only what
 // a PeerSource hands it: positions it could have received, and when.
 #include <Eigen/Core>
+#include <cmath>
 #include <span>
 #include <vector>
 
@@ -12,6 +13,9 @@ struct PeerObservation {
   int id = -1;
   Eigen::Vector3d p_world{0, 0, 0};  ///< m, ENU
   double stamp_s = 0;                ///< s sim time the position refers to
+  /// m/s, ENU; NaN where the source carries no velocity (the communication
+  /// model's messages carry positions only).
+  Eigen::Vector3d v_world{NAN, NAN, NAN};
 };
 
 class PeerSource {

@@ -146,13 +146,18 @@ Eigen::Vector3d obstacle_avoidance(std::span<const float> range_m,
 }
 
 LawTerms evaluate_law(const LawInput& in, const AgentConfig& c) {
-  LawTerms t;
+  Eigen::Vector3d swarm = Eigen::Vector3d::Zero();
   if (in.swarm_enabled)
-    t.swarm = repulsion_attraction(in.p_world, in.peers_world, in.inter_distance_m, c.activation);
-  if (in.swarm_horizontal_only) t.swarm.z() = 0;
-  Eigen::Vector3d other = t.swarm + in.mission_velocity;
+    swarm = repulsion_attraction(in.p_world, in.peers_world, in.inter_distance_m, c.activation);
+  if (in.swarm_horizontal_only) swarm.z() = 0;
+  return frame_law(in, swarm, swarm + in.mission_velocity, true, c);
+}
 
-  if (in.obstacle_avoidance_enabled) {
+LawTerms frame_law(const LawInput& in, const Eigen::Vector3d& swarm, Eigen::Vector3d other,
+                   bool obstacle_term, const AgentConfig& c) {
+  LawTerms t;
+  t.swarm = swarm;
+  if (in.obstacle_avoidance_enabled && obstacle_term) {
     t.obstacle = obstacle_avoidance(in.ray_range_m, in.ray_hit, in.ray_yaw_body_rad,
                                     in.q_world_body, c.sensor_function);
     const double safety = c.sensor_function.safety_distance_m;
@@ -186,7 +191,8 @@ LawTerms evaluate_law(const LawInput& in, const AgentConfig& c) {
     }
   }
 
-  if (in.obstacle_avoidance_enabled && !t.safety_active && c.sensor_function.slide_gain > 0) {
+  if (in.obstacle_avoidance_enabled && obstacle_term && !t.safety_active &&
+      c.sensor_function.slide_gain > 0) {
     Eigen::Vector2d n = t.obstacle.head<2>();
     const Eigen::Vector2d r = other.head<2>();
     const double n_norm = n.norm();

@@ -132,6 +132,14 @@ LawTerms evaluate_law(const LawInput& in, const AgentConfig& c);
 /// evaluate_law(in, c).velocity: the velocity command (m/s, world).
 Eigen::Vector3d control_velocity(const LawInput& in, const AgentConfig& c);
 
+/// The framework around any swarm law (ddswarm/law.hpp): other is the law's
+/// velocity, standing for C + V_mission (swarm, the law's own part, is kept
+/// for logging). With obstacle_term, C_s and its safety distance and slide
+/// act as in evaluate_law; then altitude hold and the limits. evaluate_law
+/// is frame_law with the thesis's C.
+LawTerms frame_law(const LawInput& in, const Eigen::Vector3d& swarm, Eigen::Vector3d other,
+                   bool obstacle_term, const AgentConfig& c);
+
 /// The swarm condition (thesis Eq. 3.1): every pairwise distance < epsilon_m.
 /// True for fewer than two drones.
 bool swarm_condition(std::span<const Eigen::Vector3d> positions, double epsilon_m);

@@ -51,8 +51,9 @@ inline constexpr int kApiVersion = 1;
 struct Peer {
   int id = -1;                       ///< drone id
   Eigen::Vector3d p_world{0, 0, 0};  ///< m, ENU, position estimate
-  /// m/s, ENU, velocity estimate; NaN in every component when the source
-  /// carries none (beacons always carry one, truth always has one).
+  /// m/s, ENU, velocity estimate; NaN in every component when the peer
+  /// source carries none (exact truth has one; the communication model's
+  /// messages carry positions only).
   Eigen::Vector3d v_world{0, 0, 0};
   double age_s = 0;  ///< s, sim time since the estimate was true (0 for exact truth)
 };
@@ -113,11 +114,15 @@ class ParamError : public std::invalid_argument {
  public:
   ParamError(std::string field, const std::string& value, const std::string& reason)
       : std::invalid_argument(field + " = " + value + ": " + reason),
-        field_(std::move(field)) {}
+        field_(std::move(field)),
+        value_(value),
+        reason_(reason) {}
   const std::string& field() const { return field_; }
+  const std::string& value() const { return value_; }
+  const std::string& reason() const { return reason_; }
 
  private:
-  std::string field_;
+  std::string field_, value_, reason_;
 };
 
 /// A law's parameters: `agent.law.params`, a flat mapping of names to
@@ -299,4 +304,25 @@ struct LawContext {
   double control_period_s = 0.02;  ///< s, the server's control period
 };
 
+/// What a plug-in's factory is: make one drone's law, or throw ParamError.
+using MakeLaw = std::unique_ptr<SwarmLaw> (*)(Params& p, Rng rng, const LawContext& ctx);
+
 }  // namespace ddswarm::law
+
+/// Exports a law from a plug-in library (agent.law.type: plugin). In one
+/// .cpp of the library, with make_fn a function of type law::MakeLaw:
+///
+///   std::unique_ptr<ddswarm::law::SwarmLaw> make(ddswarm::law::Params& p,
+///                                                ddswarm::law::Rng rng,
+///                                                const ddswarm::law::LawContext& ctx);
+///   DDSWARM_LAW_PLUGIN(make)
+///
+/// The agent checks ddswarm_law_api_version against its own kApiVersion and
+/// refuses a plug-in built against another.
+#define DDSWARM_LAW_PLUGIN(make_fn)                                                           \
+  extern "C" __attribute__((visibility("default"))) int ddswarm_law_api_version() {          \
+    return ::ddswarm::law::kApiVersion;                                                       \
+  }                                                                                           \
+  extern "C" __attribute__((visibility("default"))) ::ddswarm::law::MakeLaw ddswarm_law_factory() { \
+    return &(make_fn);                                                                        \
+  }
