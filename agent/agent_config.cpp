@@ -228,6 +228,10 @@ void load(YamlSection s, LawConfig& c) {
               {"vasarhelyi", LawType::kVasarhelyi},
               {"plugin", LawType::kPlugin}});
   s.get("library", c.library);
+  s.get_enum("obstacles", c.obstacles,
+             {{"auto", LawConfig::Obstacles::kAuto},
+              {"law", LawConfig::Obstacles::kLaw},
+              {"framework", LawConfig::Obstacles::kFramework}});
   s.get_enum("fault", c.fault,
              {{"none", LawConfig::Fault::kNone},
               {"nan", LawConfig::Fault::kNaN},

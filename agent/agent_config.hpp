@@ -70,6 +70,10 @@ struct LawConfig {
   /// plugin: the law's shared library (DDSWARM_LAW_PLUGIN); a relative path
   /// is taken from the working directory.
   std::string library;
+  /// Who avoids obstacles: the law's own choice (`auto`), the law alone from
+  /// the rays (`law`: no framework term C_s), or the framework (`framework`:
+  /// the law sees no rays, C_s acts), so obstacle strategies can be compared.
+  enum class Obstacles { kAuto, kLaw, kFramework } obstacles = Obstacles::kAuto;
   /// `params`: name -> scalar as written; each law reads and checks its own
   /// (thesis takes none: the agent section's activation and sensor_function
   /// configure it).

@@ -205,3 +205,39 @@ TEST(LawFrame, ALawsSeedDependsOnTheScenarioSeedAndTheDroneAlone) {
   law::Rng a(law_seed(9, 1)), b(law_seed(9, 1));
   for (int i = 0; i < 100; ++i) ASSERT_EQ(a.next(), b.next());
 }
+
+TEST(LawFrame, ObstaclesCanBeLeftToTheFrameworkOrToTheLaw) {
+  // A pillar 1.5 m ahead: the framework's fs1 pushes back; a law of its own
+  // sees the ray unless the framework takes obstacles over.
+  LawInput in;
+  in.p_world = {0, 0, 2};
+  in.altitude_target_m = 2;
+  const std::vector<float> range{1.5f}, yaw{0.0f};
+  const std::vector<std::uint8_t> hit{1};
+  in.ray_range_m = range;
+  in.ray_hit = hit;
+  in.ray_yaw_body_rad = yaw;
+  const std::vector<law::Ray> rays{{1.5, true, 0.0, 0.0}};
+  law::Observation o;
+  o.p_world = in.p_world;
+  o.rays = rays;
+  o.inter_distance_m = 4;
+  o.max_speed_mps = 3;
+  AgentConfig c;
+  law::LawContext ctx;
+  LawConfig own;
+  own.type = LawType::kVasarhelyi;
+  LawConfig by_framework = own;
+  by_framework.obstacles = LawConfig::Obstacles::kFramework;
+  auto l_own = make_law(own, ctx, law::Rng(1), c);
+  auto l_fw = make_law(by_framework, ctx, law::Rng(1), c);
+  EXPECT_FALSE(l_own->uses_obstacle_term());
+  EXPECT_TRUE(l_fw->uses_obstacle_term());
+  EXPECT_LT(l_own->step(o).velocity_world.x(), 0) << "its shill agent pushes it back";
+  EXPECT_EQ(l_fw->step(o).velocity_world.x(), 0) << "it sees no ray";
+  EXPECT_LT(step_law(l_fw.get(), o, in, c).terms.velocity.x(), -1.0) << "the framework's fs1 does";
+  LawConfig thesis_alone;
+  thesis_alone.obstacles = LawConfig::Obstacles::kLaw;
+  auto blind = make_law(thesis_alone, ctx, law::Rng(1), c);
+  EXPECT_EQ(step_law(blind.get(), o, in, c).terms.velocity.x(), 0) << "no obstacle term at all";
+}

@@ -53,6 +53,25 @@ class FaultyLaw final : public law::SwarmLaw {
   double after_s_;
 };
 
+/// agent.law.obstacles: law or framework, whatever the law would choose.
+class ObstaclesBy final : public law::SwarmLaw {
+ public:
+  ObstaclesBy(std::unique_ptr<law::SwarmLaw> inner, bool framework)
+      : inner_(std::move(inner)), framework_(framework) {}
+
+  law::Command step(const law::Observation& o) override {
+    if (!framework_) return inner_->step(o);
+    law::Observation blind = o;
+    blind.rays = {};
+    return inner_->step(blind);
+  }
+  bool uses_obstacle_term() const override { return framework_; }
+
+ private:
+  std::unique_ptr<law::SwarmLaw> inner_;
+  bool framework_;
+};
+
 }  // namespace
 
 std::unique_ptr<law::SwarmLaw> make_law(const LawConfig& c, const law::LawContext& ctx,
@@ -78,6 +97,8 @@ std::unique_ptr<law::SwarmLaw> make_law(const LawConfig& c, const law::LawContex
       break;
   }
   p.finish();
+  if (c.obstacles != LawConfig::Obstacles::kAuto)
+    l = std::make_unique<ObstaclesBy>(std::move(l), c.obstacles == LawConfig::Obstacles::kFramework);
   if (c.fault != LawConfig::Fault::kNone)
     l = std::make_unique<FaultyLaw>(std::move(l), c.fault, c.fault_after_s);
   return l;
