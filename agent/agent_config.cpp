@@ -111,6 +111,7 @@ const char* to_string(LawType t) {
     case LawType::kOlfatiSaber: return "olfati_saber";
     case LawType::kVasarhelyi: return "vasarhelyi";
     case LawType::kPlugin: return "plugin";
+    case LawType::kPython: return "python";
   }
   return "?";
 }
@@ -118,6 +119,10 @@ const char* to_string(LawType t) {
 void LawConfig::validate() const {
   if (type != LawType::kPlugin && !library.empty())
     throw FieldError(path + ".library", library, "only used with type: plugin");
+  if (type != LawType::kPython && !module.empty())
+    throw FieldError(path + ".module", module, "only used with type: python");
+  if (type != LawType::kPython && !class_name.empty())
+    throw FieldError(path + ".class", class_name, "only used with type: python");
   check_range(path + ".fault_after_s", fault_after_s, 0.0, 3600.0);
   if (fault == Fault::kNone && fault_after_s > 0)
     throw FieldError(path + ".fault_after_s", to_text(fault_after_s), "needs fault: nan or throw");
@@ -129,13 +134,14 @@ void LawConfig::validate() const {
   } catch (const law::ParamError& e) {
     throw FieldError(e.field(), e.value(), e.reason());
   } catch (const std::exception& e) {
-    throw FieldError(path + (type == LawType::kPlugin ? ".library" : ".type"),
-                     type == LawType::kPlugin ? library : to_string(type),
+    throw FieldError(path + (type == LawType::kPlugin ? ".library" : type == LawType::kPython ? ".class" : ".type"),
+                     type == LawType::kPlugin ? library : type == LawType::kPython ? class_name : to_string(type),
                      std::string("the law could not be built: ") + e.what());
   }
 }
 
 std::string LawConfig::name() const {
+  if (type == LawType::kPython) return "python " + class_name;
   if (type != LawType::kPlugin) return to_string(type);
   const auto slash = library.find_last_of('/');
   return "plugin " + (slash == std::string::npos ? library : library.substr(slash + 1));
@@ -226,8 +232,11 @@ void load(YamlSection s, LawConfig& c) {
               {"reynolds", LawType::kReynolds},
               {"olfati_saber", LawType::kOlfatiSaber},
               {"vasarhelyi", LawType::kVasarhelyi},
-              {"plugin", LawType::kPlugin}});
+              {"plugin", LawType::kPlugin},
+              {"python", LawType::kPython}});
   s.get("library", c.library);
+  s.get("module", c.module);
+  s.get("class", c.class_name);
   s.get_enum("obstacles", c.obstacles,
              {{"auto", LawConfig::Obstacles::kAuto},
               {"law", LawConfig::Obstacles::kLaw},

@@ -62,14 +62,17 @@ struct SensorFunctionConfig {
 };
 
 /// The built-in swarm laws (docs/laws.md).
-enum class LawType { kThesis, kReynolds, kOlfatiSaber, kVasarhelyi, kPlugin };
+enum class LawType { kThesis, kReynolds, kOlfatiSaber, kVasarhelyi, kPlugin, kPython };
 
 /// Which law a drone flies: YAML `agent.law` (or an override's `law`).
 struct LawConfig {
-  LawType type = LawType::kThesis;  ///< thesis | reynolds | olfati_saber | vasarhelyi | plugin
+  LawType type = LawType::kThesis;  ///< thesis | reynolds | olfati_saber | vasarhelyi | plugin | python
   /// plugin: the law's shared library (DDSWARM_LAW_PLUGIN); a relative path
   /// is taken from the working directory.
   std::string library;
+  /// python: the law's .py file (relative paths from the working directory)
+  /// and its class (docs/laws.md, "A law in Python").
+  std::string module, class_name;
   /// Who avoids obstacles: the law's own choice (`auto`), the law alone from
   /// the rays (`law`: no framework term C_s), or the framework (`framework`:
   /// the law sees no rays, C_s acts), so obstacle strategies can be compared.

@@ -1,6 +1,8 @@
 #include "agent/law_registry.hpp"
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <stdexcept>
 #include <vector>
 
@@ -76,7 +78,12 @@ class ObstaclesBy final : public law::SwarmLaw {
 
 std::unique_ptr<law::SwarmLaw> make_law(const LawConfig& c, const law::LawContext& ctx,
                                         law::Rng rng, const AgentConfig& agent) {
-  law::Params p(c.path + ".params", c.params);
+  auto values = c.params;
+  if (c.type == LawType::kPython) {
+    values["ddswarm:module"] = c.module;
+    values["ddswarm:class"] = c.class_name;
+  }
+  law::Params p(c.path + ".params", std::move(values));
   std::unique_ptr<law::SwarmLaw> l;
   switch (c.type) {
     case LawType::kThesis:
@@ -91,6 +98,17 @@ std::unique_ptr<law::SwarmLaw> make_law(const LawConfig& c, const law::LawContex
     case LawType::kVasarhelyi:
       l = laws::make_vasarhelyi(p, rng, ctx);
       break;
+    case LawType::kPython: {
+      const std::string lib = python_law_plugin();
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(lib, ec))
+        throw law::ParamError(c.path + ".type", "python",
+                              "this ddswarm was built without Python laws (" + lib +
+                                  " is missing): scripts/setup installs python3-dev and "
+                                  "python3-pybind11, then rebuild");
+      l = plugin_factory(lib, c.path + ".type")(p, rng, ctx);
+      break;
+    }
     case LawType::kPlugin:
       l = plugin_factory(c.library, c.path + ".library")(p, rng, ctx);
       if (!l) throw law::ParamError(c.path + ".library", c.library, "its factory made no law");
@@ -102,6 +120,14 @@ std::unique_ptr<law::SwarmLaw> make_law(const LawConfig& c, const law::LawContex
   if (c.fault != LawConfig::Fault::kNone)
     l = std::make_unique<FaultyLaw>(std::move(l), c.fault, c.fault_after_s);
   return l;
+}
+
+std::string python_law_plugin() {
+  if (const char* env = std::getenv("DDSWARM_PYTHON_LAW"); env && *env) return env;
+  // Beside the executables: bin/../lib/ddswarm, in the build tree as installed.
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return (exe.parent_path().parent_path() / "lib/ddswarm/libddswarm_python_law.so").string();
 }
 
 std::uint64_t law_seed(std::uint64_t scenario_seed, int drone_id) {

@@ -185,6 +185,12 @@ class Params {
     throw ParamError(field(key), *text, "must be true or false");
   }
 
+  /// Any text; def when absent.
+  std::string text(const std::string& key, const std::string& def) {
+    const std::string* t = take(key);
+    return t ? *t : def;
+  }
+
   /// One of choices; def when absent. Throws ParamError.
   std::string choice(const std::string& key, const std::string& def,
                      const std::vector<std::string>& choices) {
@@ -204,9 +210,12 @@ class Params {
     for (const auto& [key, value] : values_) {
       if (read_.count(key)) continue;
       std::string known;
-      for (const auto& k : read_) known += (known.empty() ? "" : ", ") + k;
+      auto add = [&](const std::string& k) {
+        if (k.rfind("ddswarm:", 0) != 0) known += (known.empty() ? "" : ", ") + k;  // the framework's own
+      };
+      for (const auto& k : read_) add(k);
       for (const auto& k : asked_)
-        if (!read_.count(k)) known += (known.empty() ? "" : ", ") + k;
+        if (!read_.count(k)) add(k);
       throw ParamError(field(key), value,
                        "unknown parameter" + (known.empty() ? std::string(" (this law takes none)")
                                                             : " (this law takes " + known + ")"));
