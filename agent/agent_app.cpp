@@ -567,7 +567,8 @@ struct AgentApp::Impl {
         s.agent_instance(b->instance);
         s.host(host);
         s.pid(getpid());
-        s.phase(static_cast<std::uint8_t>(b->fsm ? b->fsm->phase() : Phase::kIdle));
+        const Phase phase = !b->law_fault.empty() ? Phase::kFailsafe : b->fsm ? b->fsm->phase() : Phase::kIdle;
+        s.phase(static_cast<std::uint8_t>(phase));
         s.server_lost(server_lost);
         s.last_tick(last_tick);
         s.inter_distance_m(b->fsm ? b->fsm->inter_distance_m() : cfg.agent.inter_distance_m);

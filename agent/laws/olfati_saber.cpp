@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 namespace ddswarm::agent::laws {
 
@@ -82,8 +83,140 @@ OlfatiSaberConfig olfati_saber_config(law::Params& p) {
   c.c1_gamma = p.number("c1_gamma", c.c1_gamma, 0.0, 1000.0);
   c.c2_gamma = p.number("c2_gamma", 2.0 * std::sqrt(c.c1_gamma), 0.0, 1000.0);
   c.gamma_sigma1 = p.choice("gamma_position", "sigma1", {"linear", "sigma1"}) == "sigma1";
+  c.beta_slide = p.number("beta_slide", c.beta_slide, 0.0, 10.0);
   p.finish();
   return c;
+}
+
+namespace {
+
+constexpr double kMaxNeighbourGapRad = std::numbers::pi / 3 + 1e-9;  ///< 60°
+constexpr double kMinHorizontal = 0.5;  ///< cos 60°: steeper rays are not the ring's
+constexpr double kMaxSphereRadiusM = 100.0;
+constexpr double kSlideCommitMps = 0.05;  ///< m/s along the surface that picks the slide's side
+
+/// One ray of the scan, in the horizontal plane relative to the drone.
+struct Hit {
+  double pitch = 0, yaw = 0;  ///< rad, body: the ring and the place in it
+  Eigen::Vector2d u{0, 0};    ///< world horizontal unit direction
+  Eigen::Vector2d w{0, 0};    ///< m, hit point − q_i (horizontal)
+  bool hit = false;
+};
+
+Eigen::Vector2d normal_toward_drone(const Eigen::Vector2d& chord, const Eigen::Vector2d& w) {
+  Eigen::Vector2d a(-chord.y(), chord.x());
+  a.normalize();
+  return a.dot(w) > 0 ? Eigen::Vector2d(-a) : a;
+}
+
+}  // namespace
+
+std::vector<Obstacle> obstacles_from_rays(const law::Observation& o) {
+  std::vector<Hit> rays;
+  rays.reserve(o.rays.size());
+  for (const law::Ray& ray : o.rays) {
+    if (!std::isfinite(ray.yaw_body_rad) || !std::isfinite(ray.pitch_body_rad)) continue;
+    const double cp = std::cos(ray.pitch_body_rad);
+    const Eigen::Vector3d dir = o.q_world_body * Eigen::Vector3d(cp * std::cos(ray.yaw_body_rad),
+                                                                 cp * std::sin(ray.yaw_body_rad),
+                                                                 std::sin(ray.pitch_body_rad));
+    const Eigen::Vector2d h = dir.head<2>();
+    if (h.norm() < kMinHorizontal) continue;
+    Hit r;
+    r.pitch = ray.pitch_body_rad;
+    r.yaw = std::remainder(ray.yaw_body_rad, 2 * std::numbers::pi);
+    r.u = h.normalized();
+    r.hit = ray.hit && std::isfinite(ray.range_m);
+    r.w = r.hit ? Eigen::Vector2d(std::max(ray.range_m, 0.0) * h) : Eigen::Vector2d::Zero();
+    rays.push_back(r);
+  }
+  // Rings: by pitch, then yaw.
+  std::sort(rays.begin(), rays.end(), [](const Hit& a, const Hit& b) {
+    return a.pitch != b.pitch ? a.pitch < b.pitch : a.yaw < b.yaw;
+  });
+
+  const Eigen::Vector2d q = o.p_world.head<2>();
+  std::vector<Obstacle> out;
+  std::size_t begin = 0;
+  while (begin < rays.size()) {
+    std::size_t end = begin + 1;
+    while (end < rays.size() && rays[end].pitch == rays[begin].pitch) ++end;
+    const std::size_t n = end - begin;
+    auto at = [&](std::size_t i) -> const Hit& { return rays[begin + i % n]; };
+    // The neighbour of ring place i on side s (−1, +1) when it hit the same obstacle.
+    auto neighbour = [&](std::size_t i, int s) -> const Hit* {
+      if (n < 3) return nullptr;
+      const Hit& h = at(i);
+      const Hit& m = at(s > 0 ? i + 1 : i + n - 1);
+      if (!m.hit) return nullptr;
+      const double gap = std::abs(std::remainder(m.yaw - h.yaw, 2 * std::numbers::pi));
+      if (gap > kMaxNeighbourGapRad) return nullptr;
+      const double chord = 2 * std::max(h.w.norm(), m.w.norm()) * std::sin(gap / 2);
+      return (m.w - h.w).norm() <= 1.5 * chord ? &m : nullptr;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const Hit& h = at(i);
+      if (!h.hit) continue;
+      const double s = h.w.norm();
+      const Hit* prev = neighbour(i, -1);
+      const Hit* next = neighbour(i, +1);
+      // The local minimum: no neighbour nearer; of equal ones, the first in the ring.
+      auto beats = [&](const Hit* m, bool m_first) {
+        return m && (m->w.norm() < s || (m->w.norm() == s && m_first));
+      };
+      if (beats(prev, i > 0) || beats(next, i + 1 == n)) continue;
+
+      Obstacle k;
+      k.y = q + h.w;
+      k.a = -h.u;
+      if (prev && next) {
+        // The circle through the three hits, relative to the middle one.
+        const Eigen::Vector2d A = prev->w - h.w, C = next->w - h.w;
+        const double det = 2 * (A.x() * C.y() - A.y() * C.x());
+        bool sphere = false;
+        if (std::abs(det) > 1e-12) {
+          const Eigen::Vector2d c((C.y() * A.squaredNorm() - A.y() * C.squaredNorm()) / det,
+                                  (A.x() * C.squaredNorm() - C.x() * A.squaredNorm()) / det);
+          const Eigen::Vector2d centre = h.w + c;  // relative to q_i
+          const double R = c.norm(), dist = centre.norm();
+          // Convex toward the drone: the middle hit on the circle's near half.
+          if (R <= kMaxSphereRadiusM && dist > R && c.dot(centre) > 0) {
+            sphere = true;
+            k.sphere = true;
+            k.y = q + centre;
+            k.radius_m = std::max(R, dist - s);  // q̂ no farther than the nearest hit
+            k.a = -centre / dist;
+          }
+        }
+        if (!sphere) k.a = normal_toward_drone(next->w - prev->w, h.w);
+      } else if (prev || next) {
+        k.a = normal_toward_drone((prev ? prev : next)->w - h.w, h.w);
+      }
+      if (!k.sphere && !k.a.allFinite()) k.a = -h.u;
+      out.push_back(k);
+    }
+    begin = end;
+  }
+  return out;
+}
+
+BetaAgent beta_agent(const Obstacle& k, const Eigen::Vector2d& q, const Eigen::Vector2d& p) {
+  BetaAgent b;
+  if (k.sphere) {
+    const Eigen::Vector2d e = q - k.y;
+    const double dist = e.norm();
+    const double mu = k.radius_m / dist;
+    b.a = e / dist;
+    const Eigen::Matrix2d P = Eigen::Matrix2d::Identity() - b.a * b.a.transpose();
+    b.q = mu * q + (1 - mu) * k.y;
+    b.p = mu * P * p;
+  } else {
+    b.a = k.a;
+    const Eigen::Matrix2d P = Eigen::Matrix2d::Identity() - b.a * b.a.transpose();
+    b.q = P * q + (Eigen::Matrix2d::Identity() - P) * k.y;
+    b.p = P * p;
+  }
+  return b;
 }
 
 Eigen::Vector3d olfati_saber_acceleration(const law::Observation& o, const Eigen::Vector3d& p_self,
@@ -109,17 +242,25 @@ Eigen::Vector3d olfati_saber_acceleration(const law::Observation& o, const Eigen
       u += c.c2_alpha * bump(zs / r_alpha, c.h_alpha) * (peer.v_world - p);
   }
 
-  for (const law::Ray& ray : o.rays) {
-    if (!ray.hit || !std::isfinite(ray.range_m) || ray.range_m >= r_obst) continue;
-    const double range = std::max(ray.range_m, 0.0);
-    const double cp = std::cos(ray.pitch_body_rad);
-    const Eigen::Vector3d dir = o.q_world_body * Eigen::Vector3d(cp * std::cos(ray.yaw_body_rad),
-                                                                 cp * std::sin(ray.yaw_body_rad),
-                                                                 std::sin(ray.pitch_body_rad));
-    const double zs = sigma_norm(range, eps);
-    u += c.c1_beta * phi_beta(zs, d_beta, c.h_beta) * sigma_gradient(range * dir, eps);
-    // p̂ − p = (I − u uᵀ) p − p = −(u·p) u for the wall normal to the ray.
-    u -= c.c2_beta * bump(zs / d_beta, c.h_beta) * dir.dot(p) * dir;
+  const Eigen::Vector2d q2 = q.head<2>(), p2 = p.head<2>();
+  const Eigen::Vector2d p_r = o.mission_velocity.head<2>();
+  for (const Obstacle& k : obstacles_from_rays(o)) {
+    const BetaAgent beta = beta_agent(k, q2, p2);
+    const Eigen::Vector3d z(beta.q.x() - q2.x(), beta.q.y() - q2.y(), 0);
+    if (z.norm() >= r_obst) continue;
+    const double zs = sigma_norm(z.norm(), eps);
+    Eigen::Vector2d p_hat = beta.p;
+    const double into = c.beta_slide * std::max(0.0, -p_r.dot(beta.a));
+    if (into > 0) {
+      Eigen::Vector2d t(-beta.a.y(), beta.a.x());  // a_k turned +90°
+      const double own = t.dot(p2), lean = t.dot(p_r);
+      if (own < -kSlideCommitMps || (std::abs(own) <= kSlideCommitMps && lean < -1e-3 * p_r.norm()))
+        t = -t;
+      p_hat += std::max(0.0, into - t.dot(p_hat)) * t;
+    }
+    u += c.c1_beta * phi_beta(zs, d_beta, c.h_beta) * sigma_gradient(z, eps);
+    const Eigen::Vector2d dv = c.c2_beta * bump(zs / d_beta, c.h_beta) * (p_hat - p2);
+    u += Eigen::Vector3d(dv.x(), dv.y(), 0);
   }
 
   u -= c.c2_gamma * (p - o.mission_velocity);

@@ -48,20 +48,58 @@
 // point with a force that grows with distance, while φ_α's push fades to 0
 // as two drones meet (n_ij → 0). In FlockSim 15 drones gathering at a goal
 // 24 m away end with pairs 0.00 m apart; with σ₁ no pair ends closer than
-// 0.95 d.
+// 0.89 d. The bounded pull has a price while the goal is far: the drone
+// cruises at p_r + c1_γ/c2_γ = p_r + √c1_γ / 2 along the goal's direction
+// (1.3 m/s for a 0.8 m/s task with the defaults).
+// Why c1_γ = 1. The thesis task ends when every pair is closer than
+// 2 D_int + 1 = 9 m. Six drones arriving at the goal in a column settle, with
+// c1_γ ≤ 0.85, as a staggered 1-2-2-1 patch of the α-lattice that the goal
+// pull squeezes only to 9.25 m (0.5), 8.86 m (0.7) or 8.53 m (0.85) across:
+// the task times out at c1_γ = 0.5 on 3 of 5 seeds, and passes by 0.14 m at
+// 0.7. From c1_γ = 0.9 the pull folds the patch into a compact cluster about
+// 6.2 m across (closest pair 3.2 m). At 1.3 two drones touch on the way.
 //
-// β-agents from rays. Each ray that hits is one obstacle: the flat wall
-// through the hit point whose normal is the ray (the paper's hyperplane
-// β-agent with a_k = the ray's world direction u_k, y_k = the hit point). The
-// projection of q_i on that wall is the hit point itself and the β-agent's
-// velocity is the part of p_i along the wall:
-//   q̂_k = q_i + S_k u_k,   p̂_k = (I − u_k u_kᵀ) p_i,  so  p̂_k − p_i = −(u_k·p_i) u_k.
-// A pillar seen by several rays is several walls, each repelling: the closer
-// the drone, the more rays see it and the stronger the push. The walls carry
-// no sideways cue, so a drone whose only hitting ray points at the pillar
-// (with 16 rays: its path within about 0.4 m of a 0.5 m pillar's centre)
-// stops about 2 m short of it and stays, as potential fields do; the flock
-// around it flies on.
+// β-agents from rays (Sec. VII). The rays are read as obstacles, one β-agent
+// per obstacle, in the horizontal plane (the law is planar). A ring is the
+// rays of one body pitch, in yaw order; rays steeper than 60° are left out.
+// Two neighbouring hits (at most 60° apart) are one obstacle when their hit
+// points lie within 1.5 times the chord the ray spacing spans at their
+// range. Each hit whose range no neighbour of its obstacle beats (the
+// pattern's local minimum) is the nearest point of one obstacle, and its
+// neighbours give the surface:
+//   - both neighbours hit it: the circle through the three hit points, a
+//     sphere of centre y_k and radius R_k (seen from outside, on its near
+//     half, R_k ≤ 100 m; else the wall below). The paper's sphere β-agent:
+//       μ = R_k / ‖q_i − y_k‖,  a_k = (q_i − y_k)/‖q_i − y_k‖,  P = I − a_k a_kᵀ,
+//       q̂_k = μ q_i + (1 − μ) y_k,   p̂_k = μ P p_i;
+//     R_k is raised so that q̂_k is no farther than the nearest hit;
+//   - one neighbour hits it (or three points on a line): the wall through
+//     the hits, a_k the chord's normal facing the drone. The paper's
+//     hyperplane β-agent:  q̂_k = P q_i + (I − P) y_k,  p̂_k = P p_i;
+//   - no neighbour hits it: the wall through the hit facing the ray,
+//     a_k = −u_k, so q̂_k is the hit point and p̂_k − p_i = −(u_k·p_i) u_k.
+// With 16 rays, three hit a 0.5 m pillar from within about 0.8 m of it;
+// with the thesis course's 8 rays, a 1 m pillar only from within 0.41 m
+// (R(√2 − 1)), so there nearly every pillar is a one-ray wall. The
+// simulator's rays also hit other drones: those hits are obstacles too.
+// The slide (not in the paper; beta_slide = 0 turns it off). One hit cannot
+// tell which side of a pillar the drone is on, and a drone flying at a
+// pillar's centre sees the pillar in one ray only (with 8 rays, a 1 m pillar
+// anywhere within ±1 m of its path): a_k is then the ray, exactly against
+// the mission, and p̂_k = P p_i carries no sideways motion. Every force is
+// along the path, so the drone stops about d' short of the pillar and stays
+// (the local minimum of potential fields; on the thesis course, 2 of 6
+// drones never reached the finish). The slide moves the β-agent along the
+// surface with the part of the γ-agent's velocity that the obstacle blocks:
+//   into_k = beta_slide · max(0, −p_r·a_k),  t_k ⊥ a_k (horizontal),
+//   p̂_k ← p̂_k + max(0, into_k − t_k·p̂_k) t_k,
+// so the damping term c2_β b_ik (p̂_k − p_i) carries the drone round the
+// obstacle as fast as the obstacle holds it back, and never past that. t_k
+// points the way the drone already moves along the surface (|t_k·p_i| >
+// 0.05 m/s), else the way p_r leans (|t_k·p_r| > 10⁻³ |p_r|), else a_k turned
+// +90° (counter-clockwise: a drone flying north passes on the east), the
+// tie-break the framework's C_s slide makes. It acts only while p_r pushes
+// into the obstacle and only within d', where b_ik > 0.
 //
 // Velocity command. The paper's agents are double integrators (q̇ = p,
 // ṗ = u); our drones track a commanded velocity. The law keeps the double
@@ -74,7 +112,8 @@
 // lattice stops settling once the loop is slower: in FlockSim with a 0.6 s
 // time constant, 15 drones, 20 seeds, order after 60 s is down to 0.65,
 // against at least 0.9989 with v_c.)
-// The law is planar: u and v_c are horizontal (z = 0), distances are 3D, and
+// The law is planar: u and v_c are horizontal (z = 0), distances to peers
+// are 3D and to obstacles horizontal, and
 // the command's vertical part is the mission's (o.mission_velocity.z), which
 // the framework's altitude hold replaces when on.
 //
@@ -97,17 +136,21 @@
 //   c2_alpha       1/s    2√c1_alpha (1.10) [0, 1000]              2√c1_α
 //   c1_beta        1/s²   5                 [0, 1000]
 //   c2_beta        1/s    2√c1_beta (4.47)  [0, 1000]              2√c1_β
-//   c1_gamma       1/s²   0.5               [0, 1000]
-//   c2_gamma       1/s    2√c1_gamma (1.41) [0, 1000]              2√c1_γ
+//   c1_gamma       1/s²   1                 [0, 1000]
+//   c2_gamma       1/s    2√c1_gamma (2)    [0, 1000]              2√c1_γ
 //   gamma_position -      sigma1            linear | sigma1        linear (as written)
+//   beta_slide     -      1                 [0, 10]                0 (no slide)
 // A c2 left out follows its c1 as set. The gains make u an acceleration in
 // m/s², reading σ-norms as metres (φ and φ_β are pure numbers). c1_α stays
 // small because φ_α is stiff: at d = 4 m one pair's spring is about
 // 31 c1_α 1/s², and with c1_α = 1 the flock keeps oscillating against the
 // velocity loop's lag (order after 60 s ≥ 0.99 in 1 of 20 seeds, down to
-// 0.87). c1_β = 5 keeps drones 1.8 m or more from a pillar at up to 1 m/s.
+// 0.87). c1_β = 5 keeps drones 1.5 m or more from a pillar at up to 1 m/s
+// in FlockSim, and 1.1 m or more on the thesis course (squeezed between
+// pillars by their peers).
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "ddswarm/law.hpp"
 
@@ -150,10 +193,34 @@ struct OlfatiSaberConfig {
   double c2_alpha = 1.0954451150103321;  ///< 1/s, velocity-matching gain, default 2√c1_alpha
   double c1_beta = 5;                    ///< 1/s², obstacle repulsion gain, >= 0
   double c2_beta = 4.4721359549995796;   ///< 1/s, obstacle damping gain, default 2√c1_beta
-  double c1_gamma = 0.5;                 ///< 1/s², goal position gain, >= 0
-  double c2_gamma = 1.4142135623730951;  ///< 1/s, mission velocity gain, default 2√c1_gamma
+  double c1_gamma = 1.0;                 ///< 1/s², goal position gain, >= 0
+  double c2_gamma = 2.0;                 ///< 1/s, mission velocity gain, default 2√c1_gamma
   bool gamma_sigma1 = true;  ///< goal term −c1_γ σ₁(q − q_r); false: −c1_γ (q − q_r)
+  double beta_slide = 1;     ///< β-agents slide along the surface, [0, 10]; 0 = paper
 };
+
+/// One obstacle as the law reads it off the rays, in the horizontal plane
+/// (world x, y): a sphere (circle) of centre y and radius R, or a wall through
+/// y with unit normal a facing the drone.
+struct Obstacle {
+  bool sphere = false;
+  Eigen::Vector2d y{0, 0};  ///< m, world: the centre (sphere) or a point on the wall
+  Eigen::Vector2d a{0, 0};  ///< unit normal toward the drone (walls; spheres: from y)
+  double radius_m = 0;      ///< m, R (spheres only)
+};
+
+/// The obstacles o.rays show, one per local minimum of the ray pattern (see
+/// the header comment), relative to the drone at o.p_world.
+std::vector<Obstacle> obstacles_from_rays(const law::Observation& o);
+
+/// An obstacle's β-agent for a drone at q with velocity p (horizontal, m and
+/// m/s): the paper's projection, q̂ and p̂ (before the slide), and a_k.
+struct BetaAgent {
+  Eigen::Vector2d q{0, 0};  ///< m, world: q̂_k
+  Eigen::Vector2d p{0, 0};  ///< m/s: p̂_k
+  Eigen::Vector2d a{0, 0};  ///< unit normal at q̂_k toward the drone
+};
+BetaAgent beta_agent(const Obstacle& k, const Eigen::Vector2d& q, const Eigen::Vector2d& p);
 
 /// Reads the parameters (defaults above), checks ranges and a ≤ b, then
 /// p.finish(). Throws law::ParamError naming agent.law.params.<key>.
