@@ -230,7 +230,7 @@ TEST(AgentConfig, ALawRefusesWhatItDoesNotTakeNamingFileLineAndField) {
   EXPECT_EQ(error_of("agent:\n  law: {type: thesis, params: {gain: 2}}\n"),
             "s.yaml:2: agent.law.params.gain = 2: unknown parameter (this law takes none)");
   EXPECT_EQ(error_of("agent:\n  law: {type: boids}\n"),
-            "s.yaml:2: agent.law.type = boids: must be one of olfati_saber|plugin|reynolds|thesis|vasarhelyi");
+            "s.yaml:2: agent.law.type = boids: must be one of olfati_saber|plugin|python|reynolds|thesis|vasarhelyi");
   EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, params: {cohesion_gain: fast}}\n"),
             "s.yaml:2: agent.law.params.cohesion_gain = fast: must be a finite number");
   EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, params: {cohesion_gain: [1, 2]}}\n")

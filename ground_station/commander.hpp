@@ -46,6 +46,9 @@ struct SwarmStatus {
   std::int64_t lockstep_resends = -1;
   std::string task;             ///< the refereed task, e.g. "running 12.0 s, 2/6 past finish"; "" = none
   int drones_server_hears = -1;  ///< drones whose agent the server lists live (-1: no server heard)
+  std::string laws;  ///< the swarm laws the agents fly, e.g. "4 thesis, 2 vasarhelyi"; "" = none heard
+  /// Drones whose law faulted, e.g. "drone 3 (reynolds): threw: ...".
+  std::vector<std::string> law_faults;
 };
 
 /// The commands of the thesis console (Fig. 9), plus hold and teleop.

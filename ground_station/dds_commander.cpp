@@ -19,16 +19,28 @@
 
 namespace ddswarm::gs {
 
+namespace {
+/// v with decimals, or "n/a" when not measured (NaN).
+std::string measured(double v, int decimals) {
+  return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : "n/a";
+}
+}  // namespace
+
 std::string TaskOutcome::line() const {
   std::string lost;
   if (!lost_drones.empty()) lost = fmt::format("; lost drones (agent lost, failsafe): {}", fmt::join(lost_drones, ", "));
   if (!ok) return "task failed: " + reason + lost;
+  const SwarmTaskMetrics& m = metrics;
+  const std::string swarm = fmt::format(
+      "; order {} (min {}), mean speed {} m/s, near misses {}, components max {}, lambda2 min {}",
+      measured(m.order_mean, 2), measured(m.order_min, 2), measured(m.speed_mean_mps, 2),
+      m.near_misses, m.components_max, measured(m.lambda2_min, 2));
   return fmt::format(
       "task complete: {:.2f} s sim time (wall {:.1f} s), {} drones at {:.2f} m/s, collisions: "
       "obstacle {}, drone {}, ground {}; min inter-drone distance {:.2f} m, min obstacle "
       "clearance {:.2f} m",
       task_time_s, wall_time_s, drones, speed_mps, collisions_obstacle, collisions_drone,
-      collisions_ground, min_inter_drone_m, min_clearance_m) + lost;
+      collisions_ground, min_inter_drone_m, min_clearance_m) + swarm + lost;
 }
 
 namespace {
@@ -42,6 +54,8 @@ struct AgentSeen {
   Phase phase = Phase::kIdle;
   std::uint64_t rejected = 0;  // AgentStatus.rejected_samples
   std::string process;         // host:pid of the agent process flying it
+  std::string law;             // AgentStatus.law
+  std::string law_fault;       // AgentStatus.law_fault, empty while sound
 };
 }  // namespace
 
@@ -105,6 +119,8 @@ struct DdsCommander::Impl {
       s.phase = static_cast<Phase>(a.phase());
       s.process = a.host().to_string() + ":" + std::to_string(a.pid());
       s.rejected = a.rejected_samples();
+      s.law = a.law().to_string();
+      s.law_fault = a.law_fault().to_string();
       cv.notify_all();
     });
     ack_reader = &dds.reader<msg::MissionAck>([this](const msg::MissionAck& a, const fdds::SampleInfo&) {
@@ -420,6 +436,14 @@ CommandResult DdsCommander::task(double speed, double eps) {
   return impl_->send(c);
 }
 
+bool DdsCommander::wait_agent_statuses(double timeout_s) {
+  auto& I = *impl_;
+  std::unique_lock<std::mutex> lock(I.mu);
+  return I.cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+    return I.sim && I.agents.size() >= static_cast<std::size_t>(I.sim->num_drones());
+  });
+}
+
 bool DdsCommander::wait_task_status(double timeout_s) {
   return impl_->wait_latched_task(timeout_s, 1.0, [&] { return impl_->task.has_value(); });
 }
@@ -460,6 +484,14 @@ std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_p
       o.collisions_ground = static_cast<int>(t.collisions_ground());
       o.min_inter_drone_m = t.min_inter_drone_m();
       o.min_clearance_m = t.min_clearance_m();
+      o.metrics.order_mean = t.order_mean();
+      o.metrics.order_min = t.order_min();
+      o.metrics.speed_mean_mps = t.speed_mean_mps();
+      o.metrics.near_misses = t.near_misses();
+      o.metrics.components_max = t.components_max();
+      o.metrics.lambda2_min = t.lambda2_min();
+      o.metrics.range_m = t.metrics_range_m();
+      o.metrics.near_miss_m = t.near_miss_m();
       o.seed = I.scene_seed;
       o.scenario = I.scene_name;
       break;
@@ -555,6 +587,12 @@ SwarmStatus DdsCommander::status() {
     for (const auto& [id, a] : impl_->agents) by_agents += a.rejected;
     s.rejected.emplace_back("agents", by_agents);
   }
+  std::map<std::string, int> laws;
+  for (const auto& [id, a] : impl_->agents) {
+    if (!a.law.empty()) laws[a.law]++;
+    if (!a.law_fault.empty()) s.law_faults.push_back(fmt::format("drone {} ({}): {}", id, a.law, a.law_fault));
+  }
+  for (const auto& [l, k] : laws) s.laws += fmt::format("{}{} {}", s.laws.empty() ? "" : ", ", k, l);
   std::map<Phase, int> phases;
   for (const auto& [id, a] : impl_->agents) phases[a.phase]++;
   for (const auto& [p, k] : phases) s.task_phase += fmt::format("{}{} {}", s.task_phase.empty() ? "" : ", ", k, to_string(p));

@@ -9,6 +9,7 @@
 
 #include "common/dds_config.hpp"
 #include "common/mission.hpp"
+#include "common/swarm_metrics.hpp"
 #include "ground_station/commander.hpp"
 #include "ground_station/gs_config.hpp"
 #include "ground_station/trace.hpp"
@@ -33,6 +34,7 @@ struct TaskOutcome {
   std::uint64_t seed = 0;     ///< the scenario's seed (from the server's Scene)
   std::string scenario;       ///< the scenario's name
   std::vector<int> lost_drones;  ///< drones whose agent was lost during the task
+  SwarmTaskMetrics metrics;      ///< the task's swarm metrics, as the server gathered them
   std::string line() const;  ///< the one-line result
 };
 
@@ -102,6 +104,9 @@ class DdsCommander final : public Commander {
   /// Waits until the server's (latched) task status has arrived, if it has
   /// one. False on timeout (e.g. no task was ever run).
   bool wait_task_status(double timeout_s);
+  /// Waits up to timeout_s until a heartbeat (AgentStatus) was heard from
+  /// every drone of the server's scenario; false when some were not.
+  bool wait_agent_statuses(double timeout_s);
   SwarmStatus status() override;
   /// Every drone as the latest swarm state shows it (the first call waits up
   /// to timeout_s; a new reader gets the server's newest state at once);

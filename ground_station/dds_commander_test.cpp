@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include "common/participant.hpp"
@@ -157,6 +158,35 @@ TEST(Experiment, ARunWhoseSwarmNeverCameUpStartsAgain) {
   TaskOutcome refused;
   refused.reason = "task: refused";
   EXPECT_FALSE(start_run_again(refused, false, 1));
+}
+
+// The result line: the texts scripts grep stay as they were, the swarm
+// metrics follow them, and what was not measured reads n/a.
+TEST(TaskOutcome, ResultLineKeepsItsTextsAndAddsTheSwarmMetrics) {
+  TaskOutcome o;
+  o.ok = true;
+  o.task_time_s = 81.06;
+  o.wall_time_s = 2.9;
+  o.drones = 6;
+  o.speed_mps = 0.8;
+  o.min_inter_drone_m = 1.9;
+  o.min_clearance_m = 0.85;
+  o.metrics.order_mean = 0.934;
+  o.metrics.order_min = -0.12;
+  o.metrics.speed_mean_mps = 0.781;
+  o.metrics.near_misses = 2;
+  o.metrics.components_max = 1;
+  o.metrics.lambda2_min = 1.234;
+  EXPECT_EQ(o.line(),
+            "task complete: 81.06 s sim time (wall 2.9 s), 6 drones at 0.80 m/s, collisions: "
+            "obstacle 0, drone 0, ground 0; min inter-drone distance 1.90 m, min obstacle "
+            "clearance 0.85 m; order 0.93 (min -0.12), mean speed 0.78 m/s, near misses 2, "
+            "components max 1, lambda2 min 1.23");
+  o.metrics.lambda2_min = std::nan("");  // above sim.metrics_lambda2_max_drones
+  o.lost_drones = {3};
+  EXPECT_NE(o.line().find("lambda2 min n/a; lost drones (agent lost, failsafe): 3"),
+            std::string::npos)
+      << o.line();
 }
 
 }  // namespace

@@ -326,6 +326,7 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
     rec.collisions_ground = o.collisions_ground;
     rec.min_inter_drone_m = o.min_inter_drone_m;
     rec.min_clearance_m = o.min_clearance_m;
+    rec.metrics = o.metrics;
     std::lock_guard<std::mutex> lock(mu);
     append_csv(csv, rec);
     ++done;
@@ -349,11 +350,14 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
     if (r) finished_records.push_back(*r);
   auto summary = summarize(finished_records);
   const std::string table = markdown_table(summary);
+  const std::string metrics = metrics_table(summary);
   {
     std::ofstream f(opt.out_dir + "/" + slug(cfg.name) + ".md");
     f << "# " << cfg.name << "\n\n" << table << "\n";
+    if (!metrics.empty()) f << "## Swarm metrics\n\n" << metrics << "\n";
   }
   out << "\n" << table << "\n";
+  if (!metrics.empty()) out << "Swarm metrics:\n\n" << metrics << "\n";
   try {
     write_plots(finished_records, opt.out_dir + "/plots");
     out << "plots: " << opt.out_dir << "/plots\n";

@@ -51,6 +51,7 @@ void append_result(const std::string& csv, const TaskOutcome& o, int drones) {
   rec.collisions_ground = o.collisions_ground;
   rec.min_inter_drone_m = o.min_inter_drone_m;
   rec.min_clearance_m = o.min_clearance_m;
+  rec.metrics = o.metrics;
   append_csv(csv, rec);
 }
 
@@ -192,6 +193,12 @@ int main(int argc, char** argv) {
     trace->add_option("--every", trace_every, "keep one tick in N")->check(CLI::Range(1, 100000));
     trace->add_option("--duration", trace_duration, "wall seconds (0 = until Ctrl-C)")
         ->check(finite_range(0.0, 1e9));
+    std::string trace_metrics;
+    double trace_metrics_range = 0;
+    trace->add_option("--metrics", trace_metrics, "also write the swarm metrics of every traced tick to this CSV");
+    trace->add_option("--metrics-range", trace_metrics_range,
+                      "m, communication range of the metrics (0 = the scenario's sim.metrics_range_m)")
+        ->check(finite_range(0.0, 100000.0));
     auto* experiment = app.add_subcommand("experiment", "run an experiment file (e.g. config/table1.yaml)");
     std::string exp_file, out_dir = "results";
     experiment->add_option("file", exp_file, "experiment YAML")->required();
@@ -268,9 +275,13 @@ int main(int argc, char** argv) {
     }
 
     if (*trace) {
-      SwarmTrace t(file.dds, trace_out, trace_every);
+      TraceMetrics metrics{trace_metrics, scenario_metrics_options(config)};
+      if (trace_metrics_range > 0) metrics.options.range_m = trace_metrics_range;
+      SwarmTrace t(file.dds, trace_out, trace_every, metrics);
       t.run(trace_duration);
       std::printf("%ld rows written to %s\n", t.rows(), trace_out.c_str());
+      if (!trace_metrics.empty())
+        std::printf("%ld rows written to %s\n", t.metrics_rows(), trace_metrics.c_str());
       return 0;
     }
     const bool interactive = app.get_subcommands().empty() || *menu;
@@ -369,9 +380,13 @@ int main(int argc, char** argv) {
     }
     if (*status) {
       gs.wait_task_status(file.gs.discovery_timeout_s);  // latched: follows the match when there is one
+      // Heartbeats come 4 times a second: a second hears every live agent's
+      // phase, law and law fault.
+      gs.wait_agent_statuses(1.0);
       const SwarmStatus st = gs.status();
       std::printf("%s\n%s\n", format_status(st).c_str(), format_rejections(st).c_str());
       if (const std::string c = format_commands(st); !c.empty()) std::printf("%s\n", c.c_str());
+      for (const auto& f : st.law_faults) std::printf("law fault: %s\n", f.c_str());
       if (status_drones) {
         auto snap = gs.swarm_snapshot(file.gs.discovery_timeout_s);
         if (!snap) {

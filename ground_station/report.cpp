@@ -51,9 +51,16 @@ const std::vector<std::string> kColumns = {"set_name",
                                            "min_clearance_m",
                                            "params"};
 
+/// After params, so that the older columns keep their positions; optional
+/// when reading (files written before them).
+const std::vector<std::string> kMetricColumns = {
+    "order_mean",     "order_min",   "speed_mean_mps",  "near_misses",
+    "components_max", "lambda2_min", "metrics_range_m", "near_miss_m"};
+
 std::string header_line() {
   std::string h;
   for (const auto& c : kColumns) h += (h.empty() ? "" : ",") + c;
+  for (const auto& c : kMetricColumns) h += "," + c;
   return h;
 }
 
@@ -116,7 +123,15 @@ std::string csv_row(const RunRecord& r) {
                                            number_text(r.collisions_ground),
                                            number_text(r.min_inter_drone_m),
                                            number_text(r.min_clearance_m),
-                                           encode_params(r.params)};
+                                           encode_params(r.params),
+                                           number_text(r.metrics.order_mean),
+                                           number_text(r.metrics.order_min),
+                                           number_text(r.metrics.speed_mean_mps),
+                                           number_text(r.metrics.near_misses),
+                                           number_text(r.metrics.components_max),
+                                           number_text(r.metrics.lambda2_min),
+                                           number_text(r.metrics.range_m),
+                                           number_text(r.metrics.near_miss_m)};
   std::string row;
   for (std::size_t i = 0; i < fields.size(); ++i) row += (i ? "," : "") + csv_field(fields[i]);
   return row + "\n";
@@ -450,6 +465,17 @@ std::vector<RunRecord> read_csv(const std::string& path) {
     number("min_inter_drone_m", r.min_inter_drone_m);
     number("min_clearance_m", r.min_clearance_m);
     r.params = decode_params(text("params"), fail);
+    auto metric = [&](const char* name, auto& v) {
+      if (col.count(name)) number(name, v);
+    };
+    metric("order_mean", r.metrics.order_mean);
+    metric("order_min", r.metrics.order_min);
+    metric("speed_mean_mps", r.metrics.speed_mean_mps);
+    metric("near_misses", r.metrics.near_misses);
+    metric("components_max", r.metrics.components_max);
+    metric("lambda2_min", r.metrics.lambda2_min);
+    metric("metrics_range_m", r.metrics.range_m);
+    metric("near_miss_m", r.metrics.near_miss_m);
     out.push_back(std::move(r));
   }
   return out;
@@ -473,6 +499,9 @@ std::vector<SetSummary> summarize(const std::vector<RunRecord>& records) {
     s.max_time_s = -kInf;
     std::vector<double> times;
     double collisions = 0, obstacle = 0, drone = 0, ground = 0, wall = 0;
+    double order_sum = 0, speed_sum = 0, near_sum = 0;
+    int speed_runs = 0;
+    s.min_order = s.min_lambda2 = kNaN;
     for (const RunRecord* r : runs) {
       if (r->drones != first.drones || r->d_int_m != first.d_int_m ||
           r->speed_mps != first.speed_mps || r->sensor_function != first.sensor_function ||
@@ -492,7 +521,23 @@ std::vector<SetSummary> summarize(const std::vector<RunRecord>& records) {
       // fmin ignores NaN (a run that did not measure it).
       s.min_inter_drone_m = std::fmin(s.min_inter_drone_m, r->min_inter_drone_m);
       s.min_clearance_m = std::fmin(s.min_clearance_m, r->min_clearance_m);
+      const SwarmTaskMetrics& m = r->metrics;
+      if (std::isfinite(m.order_mean)) {
+        ++s.metrics_runs;
+        order_sum += m.order_mean;
+        near_sum += m.near_misses;
+      }
+      if (std::isfinite(m.speed_mean_mps)) {
+        ++speed_runs;
+        speed_sum += m.speed_mean_mps;
+      }
+      s.min_order = std::fmin(s.min_order, m.order_min);
+      s.min_lambda2 = std::fmin(s.min_lambda2, m.lambda2_min);
+      s.max_components = std::max(s.max_components, m.components_max);
     }
+    s.mean_order = s.metrics_runs ? order_sum / s.metrics_runs : kNaN;
+    s.mean_near_misses = s.metrics_runs ? near_sum / s.metrics_runs : kNaN;
+    s.mean_speed_mps = speed_runs ? speed_sum / speed_runs : kNaN;
     s.successes = static_cast<int>(times.size());
     const double n = static_cast<double>(runs.size());
     s.mean_collisions = collisions / n;
@@ -559,6 +604,38 @@ std::string markdown_table(const std::vector<SetSummary>& sets) {
   return os.str();
 }
 
+std::string metrics_table(const std::vector<SetSummary>& sets) {
+  if (std::none_of(sets.begin(), sets.end(),
+                   [](const SetSummary& s) { return s.metrics_runs > 0; }))
+    return "";
+  using Cell = std::function<std::string(const SetSummary&)>;
+  const std::vector<std::pair<std::string, Cell>> rows = {
+      {"Avg. order", [](const SetSummary& s) { return fixed(s.mean_order, 3); }},
+      {"Min. order", [](const SetSummary& s) { return fixed(s.min_order, 3); }},
+      {"Avg. speed", [](const SetSummary& s) { return fixed(s.mean_speed_mps, 2, "m/s"); }},
+      {"Avg. near misses", [](const SetSummary& s) { return fixed(s.mean_near_misses, 2); }},
+      {"Max. components",
+       [](const SetSummary& s) {
+         return s.max_components > 0 ? std::to_string(s.max_components) : std::string("n/a");
+       }},
+      {"Min. algebraic connectivity", [](const SetSummary& s) { return fixed(s.min_lambda2, 2); }},
+      {"Runs measured", [](const SetSummary& s) {
+         return std::to_string(s.metrics_runs) + "/" + std::to_string(s.runs);
+       }}};
+  std::ostringstream os;
+  os << "| |";
+  for (const auto& s : sets) os << ' ' << md_cell(s.name) << " |";
+  os << "\n|---|";
+  for (std::size_t i = 0; i < sets.size(); ++i) os << "---|";
+  os << '\n';
+  for (const auto& [label, cell] : rows) {
+    os << "| " << label << " |";
+    for (const auto& s : sets) os << ' ' << cell(s) << " |";
+    os << '\n';
+  }
+  return os.str();
+}
+
 std::string plot_stem(const std::string& set_name) {
   std::string stem;
   for (unsigned char c : set_name) {
@@ -607,6 +684,9 @@ std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
   const bool any_mean = std::any_of(summaries.begin(), summaries.end(),
                                     [](const SetSummary& s) { return std::isfinite(s.mean_time_s); });
   if (summaries.size() > 1 && any_mean) pngs.push_back(write_summary_plot(summaries, dir));
+  if (std::any_of(summaries.begin(), summaries.end(),
+                  [](const SetSummary& s) { return s.metrics_runs > 0; }))
+    pngs.push_back(write_metrics_plot(summaries, dir));
   return pngs;
 }
 
@@ -636,6 +716,42 @@ std::string write_summary_plot(const std::vector<SetSummary>& sets, const std::s
      << "     data using 1:($4 > 0 ? $2 : 1/0):(sprintf('%d failed', $4)) with labels offset "
         "0,1.2\n";
   return render_gnuplot(dir, "summary", gp.str(), 900, 500);
+}
+
+std::string write_metrics_plot(const std::vector<SetSummary>& sets, const std::string& dir) {
+  // Two bars per set: the order the law kept (left axis; higher is more
+  // aligned) beside how close the drones came (right axis, the near misses
+  // written above), so that one law's alignment is weighed against its
+  // safety. One plot, not a multiplot: render_gnuplot replots it as SVG.
+  auto num = [](double v) { return std::isfinite(v) ? number_text(v) : std::string("NaN"); };
+  std::ostringstream dat;
+  dat << "# index mean_order min_order min_inter_drone_m mean_near_misses name\n";
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const auto& s = sets[i];
+    dat << i << ' ' << num(s.mean_order) << ' ' << num(s.min_order) << ' '
+        << num(s.min_inter_drone_m) << ' ' << num(s.mean_near_misses) << " \"";
+    for (char c : s.name) dat << (c == '"' ? '\'' : c);  // data columns quote with "
+    dat << "\"\n";
+  }
+  write_text(dir + "/metrics.dat", dat.str());
+  std::ostringstream gp;
+  gp << "data = " << gnuplot_string("metrics.dat") << "\n"  // gnuplot runs in dir
+     << "set title 'Swarm metrics per set: order and closest approach'\n"
+     << "set style fill solid 0.6 border -1\nset boxwidth 0.35\nset grid ytics\n"
+     << "set xrange [-0.6:" << sets.size() - 0.4 << "]\nset xtics rotate by -30\n"
+     << "set ylabel 'Order (velocity correlation)'\nset yrange [-1:1.15]\n"
+     << "set y2label 'Min. inter-drone distance [m]'\nset y2range [0:*]\nset y2tics\n"
+     << "set ytics nomirror\nset key top left\n"
+     << "plot data using 1:(1/0):xtic(6) notitle, \\\n"  // the set's name under its pair
+     << "     data using ($1-0.2):2 with boxes lc rgb '#2ca02c' title 'order, mean of the runs', "
+        "\\\n"
+     << "     data using ($1-0.2):3 with points pt 7 ps 1.4 lc rgb 'black' title 'order, lowest "
+        "tick', \\\n"
+     << "     data using ($1+0.2):4 axes x1y2 with boxes lc rgb '#1f77b4' title 'min. "
+        "inter-drone distance', \\\n"
+     << "     data using ($1+0.2):4:(sprintf('%.1f near misses/run', $5)) axes x1y2 with labels "
+        "offset 0,0.8 notitle\n";
+  return render_gnuplot(dir, "metrics", gp.str(), 900, 500);
 }
 
 std::string gnuplot_string(const std::string& s) {

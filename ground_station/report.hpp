@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "common/swarm_metrics.hpp"
+
 namespace ddswarm::gs {
 
 /// One simulated run of one parameter set.
@@ -29,6 +31,9 @@ struct RunRecord {
   double min_inter_drone_m = 0;  ///< m, smallest distance between two drones (inf: none)
   double min_clearance_m = 0;    ///< m, smallest drone-obstacle clearance (inf: none)
   std::map<std::string, std::string> params;  ///< other settings worth keeping (overrides)
+  /// The task's swarm metrics (NaN, 0: not measured, e.g. the swarm never
+  /// came up, or a CSV written before them).
+  SwarmTaskMetrics metrics;
 
   int collisions() const { return collisions_obstacle + collisions_drone + collisions_ground; }
 };
@@ -41,10 +46,14 @@ struct RunRecord {
 /// Format: RFC 4180 (fields with , " CR LF or edge spaces are quoted, quotes
 /// doubled); numbers in shortest round-trip form ("nan", "inf" allowed);
 /// ok as 1/0; params as key=value pairs joined by ';' with '\' escaping '\', ';', '='.
+/// The swarm metrics come after params (order_mean, order_min, speed_mean_mps,
+/// near_misses, components_max, lambda2_min, metrics_range_m, near_miss_m), so
+/// that every older column keeps its position.
 void append_csv(const std::string& path, const RunRecord& record);
 
 /// Reads every row written by append_csv. Columns are found by header name
-/// (extra columns are ignored). Throws std::runtime_error "path:line: reason"
+/// (extra columns are ignored; the swarm metrics' may be missing, as in files
+/// written before them, and read as not measured). Throws std::runtime_error "path:line: reason"
 /// on a missing file, missing column or malformed value.
 std::vector<RunRecord> read_csv(const std::string& path);
 
@@ -70,6 +79,14 @@ struct SetSummary {
   double min_inter_drone_m = 0;  ///< m, smallest over every run (inf: none recorded)
   double min_clearance_m = 0;    ///< m, smallest over every run (inf: none recorded)
   double mean_wall_time_s = 0;   ///< s, mean wall-clock time per run
+  // Swarm metrics, over the runs that measured them (metrics_runs; NaN: none).
+  int metrics_runs = 0;          ///< runs with a measured order_mean
+  double mean_order = 0;         ///< mean of the runs' order_mean
+  double min_order = 0;          ///< smallest order_min of a run
+  double mean_speed_mps = 0;     ///< m/s, mean of the runs' speed_mean_mps
+  double mean_near_misses = 0;   ///< near misses per run
+  int max_components = 0;        ///< most components of a run (0: none measured)
+  double min_lambda2 = 0;        ///< smallest lambda2_min of a run
   bool consistent = true;        ///< false when runs disagree on drones/D_int/speed/sensor/mode
 };
 
@@ -81,6 +98,12 @@ std::vector<SetSummary> summarize(const std::vector<RunRecord>& records);
 /// Avg. task time, Standard deviation, Avg. collisions, Min. inter-drone
 /// distance, Failures ("failures/runs"). Missing statistics print as "n/a".
 std::string markdown_table(const std::vector<SetSummary>& sets);
+
+/// The swarm metrics per set as a Markdown table, laid out like
+/// markdown_table: rows Avg. order, Min. order, Avg. speed, Avg. near misses,
+/// Max. components, Min. algebraic connectivity, Runs measured. "" when no set
+/// measured them.
+std::string metrics_table(const std::vector<SetSummary>& sets);
 
 /// File stem used for a set's plot files: lowercase letters, digits and '_'
 /// (e.g. "Sim 1" -> "sim_1"); never empty.
@@ -96,6 +119,13 @@ std::string plot_stem(const std::string& set_name);
 /// standard deviation (the sweep at a glance). Returns the png path; throws
 /// std::runtime_error when gnuplot fails. write_plots() calls it for 2+ sets.
 std::string write_summary_plot(const std::vector<SetSummary>& sets, const std::string& dir);
+
+/// Writes <dir>/metrics.png and .svg (and metrics.dat): per set, above, the
+/// order (bar: mean of the runs' order_mean; point: smallest order_min) and,
+/// below, the smallest inter-drone distance with the mean near misses per run
+/// written on it. Returns the png path; throws std::runtime_error when gnuplot
+/// fails. write_plots() calls it when some set measured the swarm metrics.
+std::string write_metrics_plot(const std::vector<SetSummary>& sets, const std::string& dir);
 
 /// s as a gnuplot single-quoted string (quotes doubled, line breaks as spaces).
 std::string gnuplot_string(const std::string& s);

@@ -81,6 +81,28 @@ void expect_same(const RunRecord& a, const RunRecord& b) {
   EXPECT_TRUE(same(a.min_inter_drone_m, b.min_inter_drone_m));
   EXPECT_TRUE(same(a.min_clearance_m, b.min_clearance_m));
   EXPECT_EQ(a.params, b.params);
+  EXPECT_TRUE(same(a.metrics.order_mean, b.metrics.order_mean));
+  EXPECT_TRUE(same(a.metrics.order_min, b.metrics.order_min));
+  EXPECT_TRUE(same(a.metrics.speed_mean_mps, b.metrics.speed_mean_mps));
+  EXPECT_EQ(a.metrics.near_misses, b.metrics.near_misses);
+  EXPECT_EQ(a.metrics.components_max, b.metrics.components_max);
+  EXPECT_TRUE(same(a.metrics.lambda2_min, b.metrics.lambda2_min));
+  EXPECT_TRUE(same(a.metrics.range_m, b.metrics.range_m));
+  EXPECT_TRUE(same(a.metrics.near_miss_m, b.metrics.near_miss_m));
+}
+
+/// r with swarm metrics as the referee would report them.
+RunRecord measured(RunRecord r, double order_mean, double order_min, int near_misses,
+                   int components_max = 1, double lambda2_min = 1.5) {
+  r.metrics.order_mean = order_mean;
+  r.metrics.order_min = order_min;
+  r.metrics.speed_mean_mps = 0.75;
+  r.metrics.near_misses = near_misses;
+  r.metrics.components_max = components_max;
+  r.metrics.lambda2_min = lambda2_min;
+  r.metrics.range_m = 10;
+  r.metrics.near_miss_m = 1;
+  return r;
 }
 
 TEST_F(ReportTest, CsvRoundTripKeepsAwkwardFieldsExactly) {
@@ -92,6 +114,7 @@ TEST_F(ReportTest, CsvRoundTripKeepsAwkwardFieldsExactly) {
   rows[1].seed = std::numeric_limits<std::uint64_t>::max();
   rows[1].collisions_ground = 3;
   rows[2].failure_reason = "\"";
+  rows[2] = measured(rows[2], 0.1 + 0.7, -1.0 / 3.0, 4, 2, 0.0);
   for (const auto& r : rows) append_csv(path("runs.csv"), r);
 
   const auto back = read_csv(path("runs.csv"));
@@ -114,6 +137,35 @@ TEST_F(ReportTest, AppendWritesOneHeaderAndEveryRow) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 26);
 }
 
+// The swarm metrics come after params: scripts that read the older columns by
+// position (tests/experiment_test.sh) keep reading the same ones, and a CSV
+// written before the metrics still reads, its runs not measured.
+TEST_F(ReportTest, SwarmMetricColumnsFollowTheOlderOnesAndMayBeMissing) {
+  append_csv(path("runs.csv"), measured(run("Sim 1", 0, 80), 0.9, 0.2, 3));
+  const std::string text = slurp(path("runs.csv"));
+  const std::string header = text.substr(0, text.find('\n'));
+  EXPECT_EQ(header.find("set_name,run_index,seed,drones,d_int_m,speed_mps,sensor_function,mode,ok,"
+                        "failure_reason,task_time_s,wall_time_s,collisions_obstacle,"
+                        "collisions_drone,collisions_ground,min_inter_drone_m,min_clearance_m,"
+                        "params,order_mean,order_min,speed_mean_mps,near_misses,components_max,"
+                        "lambda2_min,metrics_range_m,near_miss_m"),
+            0u)
+      << header;
+  EXPECT_NE(text.find(",0.9,0.2,0.75,3,1,1.5,10,1\n"), std::string::npos) << text;
+
+  const std::string old = path("old.csv");
+  std::ofstream(old) << header.substr(0, header.find(",order_mean")) << "\n"
+                     << "Sim 1,0,1,6,4,0.8,fs1,lockstep,1,,82.6,20,0,0,0,1.9,0.8,\n";
+  const auto back = read_csv(old);
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].task_time_s, 82.6);
+  EXPECT_TRUE(std::isnan(back[0].metrics.order_mean));
+  EXPECT_EQ(back[0].metrics.near_misses, 0u);
+  EXPECT_EQ(summarize(back)[0].metrics_runs, 0);
+  // Appending to it would mix two layouts under one header: refused.
+  EXPECT_THROW(append_csv(old, run("Sim 1", 1, 80)), std::runtime_error);
+}
+
 TEST_F(ReportTest, AppendDoesNotMergeWithACutShortRow) {
   append_csv(path("runs.csv"), run("Sim 1", 0, 80));
   { std::ofstream(path("runs.csv"), std::ios::app) << "Sim 1,1,10"; }  // a crash mid-row
@@ -124,7 +176,7 @@ TEST_F(ReportTest, AppendDoesNotMergeWithACutShortRow) {
     read_csv(path("runs.csv"));
     FAIL() << "a short row must be reported";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("runs.csv:3: expected 18 fields, found 3"),
+    EXPECT_NE(std::string(e.what()).find("runs.csv:3: expected 26 fields, found 3"),
               std::string::npos)
         << e.what();
   }
@@ -214,6 +266,38 @@ TEST(Summary, MeanAndSampleStddevOverSuccessfulRuns) {
   EXPECT_EQ(s[1].min_inter_drone_m, 1.5);
 }
 
+TEST(Summary, SwarmMetricsPerSetOverTheRunsThatMeasuredThem) {
+  auto records = two_sets();
+  records[0] = measured(records[0], 0.9, 0.5, 2);
+  records[2] = measured(records[2], 0.7, -0.1, 1, 3, 0.0);
+  records[3] = measured(records[3], 0.8, 0.3, 0);
+  // records[5] (Sim 1's failed run) measured nothing; Sim 2 none at all.
+  const auto s = summarize(records);
+  EXPECT_EQ(s[0].metrics_runs, 3);
+  EXPECT_NEAR(s[0].mean_order, 0.8, 1e-12);
+  EXPECT_EQ(s[0].min_order, -0.1);
+  EXPECT_NEAR(s[0].mean_near_misses, 1.0, 1e-12);
+  EXPECT_EQ(s[0].mean_speed_mps, 0.75);
+  EXPECT_EQ(s[0].max_components, 3);
+  EXPECT_EQ(s[0].min_lambda2, 0.0);
+  EXPECT_EQ(s[1].metrics_runs, 0);
+  EXPECT_TRUE(std::isnan(s[1].mean_order));
+  EXPECT_TRUE(std::isnan(s[1].min_lambda2));
+  EXPECT_EQ(metrics_table(s),
+            "| | Sim 1 | Sim 2 |\n"
+            "|---|---|---|\n"
+            "| Avg. order | 0.800 | n/a |\n"
+            "| Min. order | -0.100 | n/a |\n"
+            "| Avg. speed | 0.75m/s | n/a |\n"
+            "| Avg. near misses | 1.00 | n/a |\n"
+            "| Max. components | 3 | n/a |\n"
+            "| Min. algebraic connectivity | 0.00 | n/a |\n"
+            "| Runs measured | 3/4 | 0/2 |\n");
+  // Table 1 itself is unchanged by them.
+  EXPECT_EQ(markdown_table(s), markdown_table(summarize(two_sets())));
+  EXPECT_EQ(metrics_table(summarize(two_sets())), "");
+}
+
 TEST(Summary, TooFewRunsGiveNaNAndMixedSettingsAreFlagged) {
   auto records = std::vector<RunRecord>{run("Sim 1", 0, 80), run("Sim 1", 1, kNaN, false)};
   auto s = summarize(records);
@@ -292,6 +376,25 @@ TEST_F(ReportTest, PlotsEveryRunOfEachSetAsPngAndSvg) {
   EXPECT_NE(dat.find("\n1 80 NaN 0 1\n2 82 82 1 1\n3 86 86 1 1\n4 NaN NaN 2 0\n"),
             std::string::npos)
       << dat;
+}
+
+TEST_F(ReportTest, MetricsPlotShowsOrderAndClosestApproachPerSet) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed";
+  auto records = two_sets();
+  records[0] = measured(records[0], 0.9, 0.5, 2);
+  records[2] = measured(records[2], 0.7, -0.1, 1);
+  records[1] = measured(records[1], 0.95, 0.8, 0);
+  const auto pngs = write_plots(records, path("plots"));
+  ASSERT_EQ(pngs.size(), 4u) << "one plot per set, the summary, then the metrics";
+  EXPECT_EQ(pngs[3], path("plots/metrics.png"));
+  EXPECT_EQ(slurp(path("plots/metrics.png")).substr(0, 8), "\x89PNG\r\n\x1a\n");
+  EXPECT_NE(slurp(path("plots/metrics.svg")).find("<svg"), std::string::npos);
+  // Sim 1: mean order of its 2 measured runs 0.8, lowest -0.1, closest 1.9 m,
+  // 1.5 near misses per run; Sim 2: 0.95, 0.8, 1.5 m, 0.
+  EXPECT_EQ(slurp(path("plots/metrics.dat")),
+            "# index mean_order min_order min_inter_drone_m mean_near_misses name\n"
+            "0 0.8 -0.1 1.9 1.5 \"Sim 1\"\n"
+            "1 0.95 0.8 1.5 0 \"Sim 2\"\n");
 }
 
 // Every run failed (e.g. a swarm that never came up): each set's plot still

@@ -15,21 +15,31 @@
 #include "common/mission.hpp"
 #include "common/participant.hpp"
 #include "common/process.hpp"
+#include "common/scenario.hpp"
 
 namespace ddswarm::gs {
 
 struct SwarmTrace::Impl {
   FILE* f;
+  FILE* metrics_f = nullptr;
   int every;
   DdsConfig dds_cfg;
+  SwarmMetricsOptions metrics;
   std::atomic<long> rows{0};
+  std::atomic<long> metrics_rows{0};
   std::mutex mu;
   std::optional<std::uint64_t> last_tick;  // under mu
   std::unique_ptr<Participant> dds;
-  Impl(const DdsConfig& d, const std::string& path, int e)
-      : f(std::fopen(path.c_str(), "w")), every(std::max(1, e)), dds_cfg(d) {
+  Impl(const DdsConfig& d, const std::string& path, int e, const TraceMetrics& m)
+      : f(std::fopen(path.c_str(), "w")), every(std::max(1, e)), dds_cfg(d), metrics(m.options) {
     if (!f) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+    if (!m.path.empty() && !(metrics_f = std::fopen(m.path.c_str(), "w"))) {
+      const int err = errno;
+      std::fclose(f);
+      throw std::runtime_error("cannot write " + m.path + ": " + std::strerror(err));
+    }
     std::fprintf(f, "tick,sim_time_s,drone,x,y,z,vx,vy,vz,phase,flags,collisions\n");
+    if (metrics_f) std::fprintf(metrics_f, "%s\n", kTraceMetricsHeader);
     join();
   }
   /// A new participant and reader; the old one, if any, is closed first.
@@ -50,19 +60,26 @@ struct SwarmTrace::Impl {
                      d.collisions_obstacle() + d.collisions_drone() + d.collisions_ground());
         ++rows;
       }
+      if (metrics_f) {
+        std::fprintf(metrics_f, "%s\n", trace_metrics_row(s, metrics).c_str());
+        ++metrics_rows;
+      }
     });
   }
   ~Impl() {
     if (dds) dds->close();  // no callback may write to the file once it is closed
     std::lock_guard<std::mutex> lock(mu);
     std::fclose(f);
+    if (metrics_f) std::fclose(metrics_f);
   }
 };
 
-SwarmTrace::SwarmTrace(const DdsConfig& dds, const std::string& path, int every)
-    : impl_(std::make_unique<Impl>(dds, path, every)) {}
+SwarmTrace::SwarmTrace(const DdsConfig& dds, const std::string& path, int every,
+                       const TraceMetrics& metrics)
+    : impl_(std::make_unique<Impl>(dds, path, every, metrics)) {}
 SwarmTrace::~SwarmTrace() = default;
 long SwarmTrace::rows() const { return impl_->rows; }
+long SwarmTrace::metrics_rows() const { return impl_->metrics_rows; }
 void SwarmTrace::run(double duration_s) {
   const double end = wall_seconds() + (duration_s > 0 ? duration_s : 1e9);
   LeaseWatch lease(impl_->dds_cfg.lease_duration_s, wall_seconds());
@@ -126,6 +143,36 @@ SwarmSnapshot snapshot_of(const msg::SwarmState& s) {
     snap.drones.push_back(r);
   }
   return snap;
+}
+
+std::string trace_metrics_row(const msg::SwarmState& s, const SwarmMetricsOptions& o) {
+  std::vector<Eigen::Vector3d> p, v;
+  for (const auto& d : s.drones()) {
+    if (d.flags() & msg::DRONE_FAILSAFE) continue;
+    p.push_back(from_msg(d.position()));
+    v.push_back(from_msg(d.velocity()));
+  }
+  const SwarmTickMetrics m = swarm_tick_metrics(p, v, o);
+  return fmt::format("{},{:.3f},{},{:.4f},{:.4f},{:.4f},{},{},{:.4f}", s.tick(), s.sim_time_s(),
+                     m.drones, m.order, m.mean_speed_mps, m.min_distance_m, m.near_pairs,
+                     m.components, m.lambda2);
+}
+
+SwarmMetricsOptions scenario_metrics_options(const std::string& path) {
+  SwarmMetricsOptions o;
+  if (path.empty()) return o;
+  const auto doc = load_scenario(path);
+  doc.guard([&] {
+    // Only these keys: the rest of sim: is the server's to check.
+    YamlSection sim = doc.section("sim");
+    sim.get("metrics_range_m", o.range_m);
+    sim.get("near_miss_m", o.near_miss_m);
+    sim.get("metrics_lambda2_max_drones", o.lambda2_max_drones);
+    check_positive("sim.metrics_range_m", o.range_m);
+    check_positive("sim.near_miss_m", o.near_miss_m);
+    check_range("sim.metrics_lambda2_max_drones", o.lambda2_max_drones, 0, 1024);
+  });
+  return o;
 }
 
 }  // namespace ddswarm::gs

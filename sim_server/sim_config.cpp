@@ -23,6 +23,9 @@ void load(YamlSection s, SimConfig& c) {
   s.get("publish_per_drone_topics", c.publish_per_drone_topics);
   s.get("task_timeout_s", c.task_timeout_s);
   s.get("airborne_height_m", c.airborne_height_m);
+  s.get("metrics_range_m", c.metrics_range_m);
+  s.get("near_miss_m", c.near_miss_m);
+  s.get("metrics_lambda2_max_drones", c.metrics_lambda2_max_drones);
   s.finish();
 }
 
@@ -52,6 +55,21 @@ void SimConfig::validate() const {
   check_range("sim.status_rate_hz", status_rate_hz, 0.1, 100.0);
   check_positive("sim.task_timeout_s", task_timeout_s);
   check_positive("sim.airborne_height_m", airborne_height_m);
+  check_positive("sim.metrics_range_m", metrics_range_m);
+  if (metrics_range_m > 100000.0)
+    throw FieldError("sim.metrics_range_m", to_text(metrics_range_m), "must be <= 100000");
+  check_positive("sim.near_miss_m", near_miss_m);
+  if (near_miss_m > 1000.0)
+    throw FieldError("sim.near_miss_m", to_text(near_miss_m), "must be <= 1000");
+  check_range("sim.metrics_lambda2_max_drones", metrics_lambda2_max_drones, 0, 1024);
+}
+
+SwarmMetricsOptions SimConfig::metrics() const {
+  SwarmMetricsOptions o;
+  o.range_m = metrics_range_m;
+  o.near_miss_m = near_miss_m;
+  o.lambda2_max_drones = metrics_lambda2_max_drones;
+  return o;
 }
 
 }  // namespace ddswarm::sim

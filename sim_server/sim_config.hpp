@@ -1,5 +1,6 @@
 #pragma once
 // The `sim:` section: clocks, time mode behaviour, failsafes, limits.
+#include "common/swarm_metrics.hpp"
 #include "common/yaml_section.hpp"
 
 namespace ddswarm::sim {
@@ -22,9 +23,18 @@ struct SimConfig {
   bool publish_per_drone_topics = true; ///< also publish keyed DroneState/DistanceScan
   double task_timeout_s = 600.0;        ///< s sim time before a running task fails
   double airborne_height_m = 0.3;       ///< m above ground: counts as airborne
+  /// m, swarm metrics: drones this close or closer are linked in the
+  /// communication graph (components, λ₂); (0, 100000]
+  double metrics_range_m = 10.0;
+  /// m centre to centre, swarm metrics: closer is a near miss; (0, 1000]
+  double near_miss_m = 1.0;
+  /// swarm metrics: λ₂ (O(N³)) only for swarms up to this size; [0, 1024], 0 = never
+  int metrics_lambda2_max_drones = 128;
 
   int substeps() const { return static_cast<int>(physics_rate_hz / control_rate_hz + 0.5); }
   int sensor_every() const { return static_cast<int>(control_rate_hz / sensor_rate_hz + 0.5); }
+  /// The swarm metrics' options (the task referee's).
+  SwarmMetricsOptions metrics() const;
   void validate() const;
 };
 

@@ -49,11 +49,33 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
   EXPECT_EQ(error_for("dds:\n  shm_transport: udp\n"),
             "2: dds.shm_transport = udp: must be true or false");
   EXPECT_EQ(error_for("sim:\n  colour: red\n"), "2: sim.colour: unknown key");
+  EXPECT_EQ(error_for("sim:\n  task_timeout_s: 60\n  metrics_range_m: 0\n"),
+            "3: sim.metrics_range_m = 0: must be > 0");
+  EXPECT_EQ(error_for("sim:\n  near_miss_m: -0.5\n"), "2: sim.near_miss_m = -0.5: must be > 0");
+  EXPECT_EQ(error_for("sim:\n  near_miss_m: 2000\n"), "2: sim.near_miss_m = 2000: must be <= 1000");
+  EXPECT_EQ(error_for("sim:\n  metrics_lambda2_max_drones: 2048\n"),
+            "2: sim.metrics_lambda2_max_drones = 2048: must be in [0, 1024]");
+  EXPECT_EQ(error_for("sim:\n  metrics_lambda2_max_drones: many\n"),
+            "2: sim.metrics_lambda2_max_drones = many: must be an integer");
   EXPECT_EQ(error_for("wings: 2\n"), "1: wings: unknown section");
   EXPECT_EQ(error_for("sensors:\n  count: many\n"), "2: sensors.count = many: must be an integer");
   EXPECT_EQ(error_for("scene:\n  bounds_min: [0, 0, 0]\n  bounds_max: [12, 16, 15]\nsensors:\n  max_range_m: 26\n"),
             "5: sensors.max_range_m = 26: must be <= the world's size (diagonal of "
             "scene.bounds_min..bounds_max, 25 m)");
+}
+
+TEST(ServerConfig, SwarmMetricsFieldsReachTheRefereesOptions) {
+  const std::string path = ::testing::TempDir() + "/metrics_scenario.yaml";
+  std::ofstream(path) << "sim:\n  metrics_range_m: 25\n  near_miss_m: 0.6\n"
+                         "  metrics_lambda2_max_drones: 0\n";
+  const SwarmMetricsOptions o = load_server_config(path).sim.metrics();
+  EXPECT_EQ(o.range_m, 25.0);
+  EXPECT_EQ(o.near_miss_m, 0.6);
+  EXPECT_EQ(o.lambda2_max_drones, 0);
+  const SimConfig defaults;
+  EXPECT_EQ(defaults.metrics().range_m, 10.0);
+  EXPECT_EQ(defaults.metrics().near_miss_m, 1.0);
+  EXPECT_EQ(defaults.metrics().lambda2_max_drones, 128);
 }
 
 TEST(ServerConfig, MissingFileIsAClearError) {

@@ -170,7 +170,9 @@ struct SimServer::Impl {
   // Per-tick scratch, allocated once (publish_tick is on every tick's path).
   std::vector<float> ranges;
   std::vector<std::uint8_t> hits;
-  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Vector3d> positions;   // the drones that count for the task
+  std::vector<Eigen::Vector3d> velocities;  // theirs, in the same order
+  std::vector<int> counted_ids;             // and their ids
   std::vector<char> tick_live;
   std::vector<Phase> tick_phase;
   double last_task_publish_wall = -1e9;
@@ -187,7 +189,7 @@ struct SimServer::Impl {
         rt_pipelined(cfg.sim.realtime_pipeline && cfg.scenario.mode == TimeMode::kRealtime),
         starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
         world(cfg.scene, cfg.quadrotor, starts, cfg.scene.start.yaw_rad),
-        referee(cfg.scene),
+        referee(cfg.scene, cfg.sim.metrics()),
         dds(cfg.dds, kServerParticipantName),
         w_swarm(dds.writer<msg::SwarmState>()),
         w_drone(dds.writer<msg::DroneState>()),
@@ -213,6 +215,8 @@ struct SimServer::Impl {
     tick_live.assign(n, 0);
     tick_phase.assign(n, Phase::kIdle);
     positions.reserve(n);
+    velocities.reserve(n);
+    counted_ids.reserve(n);
     swarm_msg.drones().resize(n);
     swarm_msg.scans().resize(n);
     for (int i = 0; i < n; ++i) {
@@ -645,6 +649,8 @@ struct SimServer::Impl {
     const double t = sim_time();
     const bool scan_tick = tick % static_cast<std::uint64_t>(cfg.sim.sensor_every()) == 0;
     positions.clear();
+    velocities.clear();
+    counted_ids.clear();
     {
       std::lock_guard<std::mutex> lock(mu);
       // What the callbacks keep per drone, read once for the whole tick.
@@ -692,9 +698,11 @@ struct SimServer::Impl {
       std::uint16_t flags = 0;
       bool airborne = st.p_world.z() > cfg.scene.ground_z_m + cfg.sim.airborne_height_m;
       if (airborne) flags |= msg::DRONE_AIRBORNE;
-      if (failsafe_since[i] >= 0) flags |= msg::DRONE_FAILSAFE;
-      if (tick_live[i]) flags |= msg::DRONE_AGENT_LIVE;
       const Phase phase = tick_phase[i];
+      // In failsafe: the server flies it (its agent is lost), or its agent
+      // does (the drone's swarm law faulted).
+      if (failsafe_since[i] >= 0 || phase == Phase::kFailsafe) flags |= msg::DRONE_FAILSAFE;
+      if (tick_live[i]) flags |= msg::DRONE_AGENT_LIVE;
       if ((st.p_world.array() < cfg.scene.bounds_min.array()).any() ||
           (st.p_world.array() > cfg.scene.bounds_max.array()).any())
         flags |= msg::DRONE_OUT_OF_BOUNDS;
@@ -711,14 +719,18 @@ struct SimServer::Impl {
         sc.range_m().assign(ranges.begin(), ranges.end());
         sc.hit().assign(hits.begin(), hits.end());
       }
-      // A drone in failsafe (its agent lost) no longer counts for the task.
-      if (failsafe_since[i] < 0)
+      // A drone in failsafe (its agent lost, or its law faulted) no longer counts for the task.
+      if (failsafe_since[i] < 0 && phase != Phase::kFailsafe) {
         positions.push_back(st.p_world);
-      else
+        velocities.push_back(st.v_world);
+        counted_ids.push_back(i);
+      } else {
         referee.note_lost(i);
+      }
     }
     for (auto& b : swarm_msg.beacons()) b.true_position(swarm_msg.drones()[b.drone_id()].position());
-    bool task_changed = referee.update(t, positions, cfg.sim.task_timeout_s);
+    bool task_changed =
+        referee.update(t, positions, velocities, counted_ids, cfg.sim.task_timeout_s);
     w_swarm.write(swarm_msg);
     // Best-effort, volatile topics: with no reader matched (no recorder or
     // tool listening) the 2N writes would only serialize into the history.
@@ -761,6 +773,17 @@ struct SimServer::Impl {
     m.collisions_drone(r.collisions_drone);
     m.collisions_ground(r.collisions_ground);
     for (int id : r.lost_drones) m.lost_drones().push_back(static_cast<std::uint16_t>(id));
+    m.order(r.order);
+    m.order_mean(r.metrics.order_mean);
+    m.order_min(r.metrics.order_min);
+    m.speed_mean_mps(r.metrics.speed_mean_mps);
+    m.near_misses(r.metrics.near_misses);
+    m.components(static_cast<std::uint16_t>(r.components));
+    m.components_max(static_cast<std::uint16_t>(r.metrics.components_max));
+    m.lambda2(r.lambda2);
+    m.lambda2_min(r.metrics.lambda2_min);
+    m.metrics_range_m(r.metrics.range_m);
+    m.near_miss_m(r.metrics.near_miss_m);
     w_task.write(m);
     if (changed && r.phase == TaskPhase::kComplete)
       spdlog::info("task complete: {:.2f} s sim, {} obstacle / {} drone / {} ground collisions, "
@@ -827,7 +850,7 @@ struct SimServer::Impl {
     std::uint32_t co = 0, cd = 0, cg = 0;
     for (int i = 0; i < n; ++i) {
       airborne += swarm_msg.drones()[i].flags() & msg::DRONE_AIRBORNE ? 1 : 0;
-      failsafe += failsafe_since[i] >= 0;
+      failsafe += (swarm_msg.drones()[i].flags() & msg::DRONE_FAILSAFE) ? 1 : 0;
       co += coll_obstacle[i];
       cd += coll_drone[i];
       cg += coll_ground[i];

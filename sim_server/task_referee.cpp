@@ -15,6 +15,8 @@ void TaskReferee::start(std::uint32_t seq, double t, double epsilon_m, double sp
   r_.drones = drones;
   r_.min_inter_drone_m = std::numeric_limits<double>::infinity();
   r_.min_clearance_m = std::numeric_limits<double>::infinity();
+  metrics_.reset();
+  r_.metrics = metrics_.summary();
 }
 
 void TaskReferee::fail(const std::string& reason) {
@@ -36,19 +38,22 @@ void TaskReferee::count_collision(int kind) {
   if (kind == 2) ++r_.collisions_ground;
 }
 
-bool TaskReferee::update(double t, const std::vector<Eigen::Vector3d>& p, double timeout_s) {
+bool TaskReferee::update(double t, const std::vector<Eigen::Vector3d>& p,
+                         const std::vector<Eigen::Vector3d>& v, const std::vector<int>& ids,
+                         double timeout_s) {
   if (r_.phase != TaskPhase::kRunning) return false;
   r_.elapsed_s = t - r_.start_sim_time_s;
   r_.drones = static_cast<int>(p.size());
-  double max_pair = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    for (std::size_t j = i + 1; j < p.size(); ++j) {
-      double d = (p[i] - p[j]).norm();
-      max_pair = std::max(max_pair, d);
-      r_.min_inter_drone_m = std::min(r_.min_inter_drone_m, d);
-    }
-    r_.min_clearance_m = std::min(r_.min_clearance_m, scene_.clearance(p[i]));
-  }
+  // One pass over the pairs gives the thesis's distances and the metrics.
+  const SwarmTickMetrics tick = swarm_tick_metrics(p, v, metrics_options_);
+  metrics_.add(tick, ids);
+  r_.metrics = metrics_.summary();
+  r_.order = tick.order;
+  r_.lambda2 = tick.lambda2;
+  r_.components = tick.components;
+  const double max_pair = tick.max_distance_m;
+  r_.min_inter_drone_m = std::min(r_.min_inter_drone_m, tick.min_distance_m);
+  for (const auto& q : p) r_.min_clearance_m = std::min(r_.min_clearance_m, scene_.clearance(q));
   r_.max_pair_distance_m = max_pair;
   r_.past_finish = static_cast<int>(std::count_if(
       p.begin(), p.end(), [&](const Eigen::Vector3d& q) { return scene_.past_finish(q.head<2>()); }));

@@ -5,13 +5,17 @@
 // first tick where every counted drone is past the finish line and every
 // pairwise distance is below epsilon (Eq. 3.1). It also tracks what Table 1
 // reports: collisions by kind, the minimum inter-drone distance and the
-// minimum clearance to obstacles. Pure: positions in, status out.
+// minimum clearance to obstacles; and the swarm metrics of every tick
+// (common/swarm_metrics.hpp), which only observe. Pure: positions and
+// velocities in, status out.
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "common/scene.hpp"
+#include "common/swarm_metrics.hpp"
 
 namespace ddswarm::sim {
 
@@ -32,18 +36,30 @@ struct TaskReport {
   double min_clearance_m = 0;
   std::uint32_t collisions_obstacle = 0, collisions_drone = 0, collisions_ground = 0;
   std::vector<int> lost_drones;  ///< drones whose agent was lost while the task ran, ascending
+  SwarmTaskMetrics metrics;      ///< the swarm metrics over the task's ticks so far
+  /// The latest tick's φ_corr, λ₂ and components (NaN, NaN, 0 before the first).
+  double order = std::numeric_limits<double>::quiet_NaN();
+  double lambda2 = std::numeric_limits<double>::quiet_NaN();
+  int components = 0;
 };
 
 class TaskReferee {
  public:
-  explicit TaskReferee(const SceneConfig& scene) : scene_(scene) {}
+  /// metrics: the communication range, near-miss distance and λ₂ size limit
+  /// of the swarm metrics.
+  explicit TaskReferee(const SceneConfig& scene, const SwarmMetricsOptions& metrics = {})
+      : scene_(scene), metrics_options_(metrics), metrics_(metrics) {}
 
   void start(std::uint32_t seq, double sim_time_s, double epsilon_m, double speed_mps, int drones);
   /// Stops a running task as failed with reason (e.g. "aborted by land").
   void fail(const std::string& reason);
-  /// One tick: positions of the drones that count (lost drones excluded by
-  /// the caller), and the time limit. Returns true when the phase changed.
-  bool update(double sim_time_s, const std::vector<Eigen::Vector3d>& positions, double timeout_s);
+  /// One tick: the drones that count (lost drones excluded by the caller),
+  /// drone ids[k] at positions[k] (m) flying velocities[k] (m/s), world ENU,
+  /// all three the same size; and the time limit. Returns true when the phase
+  /// changed.
+  bool update(double sim_time_s, const std::vector<Eigen::Vector3d>& positions,
+              const std::vector<Eigen::Vector3d>& velocities, const std::vector<int>& ids,
+              double timeout_s);
   /// Counts a collision that began during the task.
   void count_collision(int kind);  // 0 obstacle, 1 drone, 2 ground
   /// Records that drone id's agent was lost (failsafe) while the task runs.
@@ -54,6 +70,8 @@ class TaskReferee {
 
  private:
   const SceneConfig& scene_;
+  SwarmMetricsOptions metrics_options_;
+  SwarmMetricsAccumulator metrics_;
   TaskReport r_;
 };
 
