@@ -19,6 +19,9 @@ constexpr double kTinySpeedMps = 1e-3;
 /// A ray whose world direction has a horizontal part below this (about 6°
 /// from vertical) sees no horizontal obstacle.
 constexpr double kMinHorizontal = 0.1;
+/// The slide: a propulsion within this sine (about 1°) of the obstacle's
+/// direction is dead centre.
+constexpr double kDeadCentre = 0.02;
 
 bool finite2(const Eigen::Vector2d& v) { return std::isfinite(v.x()) && std::isfinite(v.y()); }
 
@@ -39,6 +42,17 @@ Config scaled(const Config& c, double length_scale, double speed_scale) {
   out.v_shill_mps = c.v_shill_mps * k;
   out.p_shill = c.p_shill * rate;
   out.a_shill = c.a_shill * accel;
+  return out;
+}
+
+Config scaled(const Config& c, double length_scale, double speed_scale, double shill_speed_scale,
+              double shill_scale) {
+  Config out = scaled(c, length_scale, speed_scale);
+  const Config shill = scaled(c, length_scale * shill_scale, shill_speed_scale);
+  out.r0_shill_m = shill.r0_shill_m;
+  out.v_shill_mps = shill.v_shill_mps;
+  out.p_shill = shill.p_shill;
+  out.a_shill = shill.a_shill;
   return out;
 }
 
@@ -137,17 +151,29 @@ Eigen::Vector2d self_propulsion(const Eigen::Vector2d& v_i, const Eigen::Vector3
   return c.v_flock_mps * v_i / speed;
 }
 
-Eigen::Vector2d slide(const Eigen::Vector2d& propulsion, const Eigen::Vector2d& toward_obstacle) {
-  const double blocked = propulsion.dot(toward_obstacle);
-  if (!(blocked > 0)) return propulsion;
-  // The side the propulsion leans to; left of the obstacle when dead centre.
-  const double side = toward_obstacle.x() * propulsion.y() - toward_obstacle.y() * propulsion.x();
+int slide_side(const Eigen::Vector2d& propulsion, const Eigen::Vector2d& toward_obstacle, int tie) {
   const Eigen::Vector2d left(-toward_obstacle.y(), toward_obstacle.x());
-  const Eigen::Vector2d tangent = side < 0 ? Eigen::Vector2d(-left) : left;
-  return propulsion - blocked * toward_obstacle + blocked * tangent;
+  const double lean = left.dot(propulsion);
+  if (!(std::abs(lean) > kDeadCentre * propulsion.norm())) return tie < 0 ? -1 : 1;
+  return lean < 0 ? -1 : 1;
 }
 
-Terms evaluate(const law::Observation& o, const Config& c) {
+Eigen::Vector2d slide(const Eigen::Vector2d& propulsion, const Eigen::Vector2d& toward_obstacle,
+                      int side, double amount) {
+  const double blocked = propulsion.dot(toward_obstacle);
+  if (!(blocked > 0)) return propulsion;
+  const double c = std::clamp(std::isnan(amount) ? 0.0 : amount, 0.0, blocked);
+  const Eigen::Vector2d left(-toward_obstacle.y(), toward_obstacle.x());
+  const Eigen::Vector2d tangent = side < 0 ? Eigen::Vector2d(-left) : left;
+  return propulsion - c * toward_obstacle + c * tangent;
+}
+
+Eigen::Vector2d slide(const Eigen::Vector2d& propulsion, const Eigen::Vector2d& toward_obstacle) {
+  return slide(propulsion, toward_obstacle, slide_side(propulsion, toward_obstacle, 1),
+               propulsion.dot(toward_obstacle));
+}
+
+Terms evaluate(const law::Observation& o, const Config& c, SlideMemory* memory) {
   Terms t;
   const Eigen::Vector2d r_i = o.p_world.head<2>();
   Eigen::Vector2d v_i = o.v_world.head<2>();
@@ -161,24 +187,45 @@ Terms evaluate(const law::Observation& o, const Config& c) {
     if (finite2(v_j)) t.friction += friction(r_i, v_i, r_j, v_j, c);
   }
   const ShillAgent* strongest = nullptr;
-  double strongest_mps = 0;
+  Eigen::Vector2d strongest_term(0, 0);
   const std::vector<ShillAgent> agents = shill_agents(o.rays, o.q_world_body, c.shill_agents);
   for (const auto& s : agents) {
     const Eigen::Vector2d term = shill(v_i, s.toward_obstacle, s.distance_m, c);
     t.shill += term;
-    if (term.norm() > strongest_mps) {
-      strongest_mps = term.norm();
+    if (term.norm() > strongest_term.norm()) {
+      strongest_term = term;
       strongest = &s;
     }
   }
   const Eigen::Vector2d m = o.mission_velocity.head<2>();
-  if (c.slide && strongest && finite2(m) && m.norm() > 0)
-    t.propulsion = slide(t.propulsion, strongest->toward_obstacle);
+  const bool propelled = finite2(m) && m.norm() > 0;
+  if (c.slide && strongest && propelled) {
+    const Eigen::Vector2d& u = strongest->toward_obstacle;
+    // The part of the propulsion the agent cancels.
+    const double cancelled = std::min(t.propulsion.dot(u), -strongest_term.dot(u));
+    if (cancelled > 0) {
+      // Dead centre: the side kept from the last second, else the goal's, else left.
+      int tie = 1;
+      if (memory && memory->side != 0 && o.sim_time_s - memory->time_s <= kSlideMemoryS) {
+        tie = memory->side;
+      } else {
+        const Eigen::Vector2d to_goal = o.goal_world.head<2>() - r_i;
+        if (finite2(to_goal) && to_goal.norm() > 0) tie = slide_side(to_goal, u, 1);
+      }
+      const int side = slide_side(t.propulsion, u, tie);
+      t.propulsion = slide(t.propulsion, u, side, cancelled);
+      if (memory) *memory = {side, o.sim_time_s};
+    }
+  }
 
   t.velocity = t.propulsion + t.repulsion + t.friction + t.shill;
   const double v_max = std::max(0.0, std::min(c.v_max_mps, o.max_speed_mps));
   const double speed = t.velocity.norm();
   if (speed > v_max) t.velocity *= v_max / speed;
+  // Speed: never slower than the mission while heading forward.
+  const double floor = propelled ? std::min(v_max, m.norm()) : 0.0;
+  if (c.keep_speed && speed > 0 && speed < floor && t.velocity.dot(m) > 0)
+    t.velocity *= floor / speed;
   return t;
 }
 
@@ -197,12 +244,15 @@ std::string text(double v) {
 class VasarhelyiLaw final : public law::SwarmLaw {
  public:
   /// paper: the unscaled set with v_flock, v_max and the choices in force;
+  /// speed_scale: k; shill_scale: the shill set's length factor;
   /// length_scale: s, or nullopt to follow D_int; overrides: the values
   /// given explicitly, applied after scaling.
-  VasarhelyiLaw(Config paper, double speed_scale, std::optional<double> length_scale,
-                double d_int_m, std::vector<std::pair<double Config::*, double>> overrides)
+  VasarhelyiLaw(Config paper, double speed_scale, double shill_scale,
+                std::optional<double> length_scale, double d_int_m,
+                std::vector<std::pair<double Config::*, double>> overrides)
       : paper_(paper),
         speed_scale_(speed_scale),
+        shill_scale_(shill_scale),
         length_scale_(length_scale),
         d_int_m_(d_int_m),
         overrides_(std::move(overrides)) {}
@@ -210,13 +260,17 @@ class VasarhelyiLaw final : public law::SwarmLaw {
   law::Command step(const law::Observation& o) override {
     const double d_int = o.inter_distance_m > 0 ? o.inter_distance_m : d_int_m_;
     const double s = length_scale_.value_or(d_int / vasarhelyi::kPaperSpacingM);
-    if (!config_ || s != config_s_) {
-      Config c = vasarhelyi::scaled(paper_, s, speed_scale_);
+    const double k_shill = paper_.shill_speed == vasarhelyi::ShillSpeed::kPropulsion
+                               ? propulsion_speed(o) / vasarhelyi::kPaperVFlockMps
+                               : speed_scale_;
+    if (!config_ || s != config_s_ || k_shill != config_k_shill_) {
+      Config c = vasarhelyi::scaled(paper_, s, speed_scale_, k_shill, shill_scale_);
       for (const auto& [field, value] : overrides_) c.*field = value;
       config_ = c;
       config_s_ = s;
+      config_k_shill_ = k_shill;
     }
-    const vasarhelyi::Terms t = vasarhelyi::evaluate(o, *config_);
+    const vasarhelyi::Terms t = vasarhelyi::evaluate(o, *config_, &slide_memory_);
     law::Command cmd;
     const double vz = std::isfinite(o.mission_velocity.z()) ? o.mission_velocity.z() : 0.0;
     cmd.velocity_world = Eigen::Vector3d(t.velocity.x(), t.velocity.y(), vz);
@@ -226,13 +280,33 @@ class VasarhelyiLaw final : public law::SwarmLaw {
   bool uses_obstacle_term() const override { return false; }
 
  private:
+  /// v_p (m/s, "Shill agents' speed" in the header): the mission's
+  /// horizontal speed; in a gathering the larger of it and the last cruise
+  /// speed; v_flock without a mission velocity; in [0.1 m/s, v_max].
+  double propulsion_speed(const law::Observation& o) {
+    const Eigen::Vector2d m = o.mission_velocity.head<2>();
+    const double mission = std::isfinite(m.x()) && std::isfinite(m.y()) ? m.norm() : 0.0;
+    double v = paper_.v_flock_mps;
+    if (mission > 0 && o.phase == law::Phase::kSwarm) {
+      v = std::max(mission, cruise_mps_);
+    } else if (mission > 0) {
+      v = mission;
+      cruise_mps_ = mission;
+    }
+    return std::clamp(v, vasarhelyi::kMinPropulsionMps,
+                      std::max(vasarhelyi::kMinPropulsionMps, paper_.v_max_mps));
+  }
+
   Config paper_;
   double speed_scale_;
+  double shill_scale_;
   std::optional<double> length_scale_;
   double d_int_m_;
   std::vector<std::pair<double Config::*, double>> overrides_;
-  std::optional<Config> config_;  // the scaled set for config_s_
-  double config_s_ = 0;
+  std::optional<Config> config_;  // the scaled set for config_s_ and config_k_shill_
+  double config_s_ = 0, config_k_shill_ = 0;
+  double cruise_mps_ = 0;  // m/s, the last mission speed outside a gathering
+  vasarhelyi::SlideMemory slide_memory_;
 };
 
 }  // namespace
@@ -253,7 +327,9 @@ std::unique_ptr<law::SwarmLaw> make_vasarhelyi(law::Params& p, law::Rng /*rng*/,
     throw law::ParamError(p.prefix() + ".v_flock_mps", text(paper.v_flock_mps),
                           "must be <= v_max_mps (" + text(paper.v_max_mps) + ")");
   const double k = paper.v_flock_mps / vasarhelyi::kPaperVFlockMps;
-  const Config shown = vasarhelyi::scaled(paper, s, k);  // the defaults at D_int in ctx
+  const double shill_scale = p.number("shill_scale", 1.0, 0.05, 20);
+  // The defaults at D_int in ctx (the shill set as in hold: k_s = k).
+  const Config shown = vasarhelyi::scaled(paper, s, k, k, shill_scale);
 
   struct Field {
     const char* key;
@@ -281,9 +357,14 @@ std::unique_ptr<law::SwarmLaw> make_vasarhelyi(law::Params& p, law::Rng /*rng*/,
                            ? vasarhelyi::ShillAgents::kEveryRay
                            : vasarhelyi::ShillAgents::kNearest;
   paper.slide = p.flag("slide", true);
+  paper.shill_speed = p.choice("shill_speed", "propulsion", {"propulsion", "v_flock"}) == "v_flock"
+                          ? vasarhelyi::ShillSpeed::kVFlock
+                          : vasarhelyi::ShillSpeed::kPropulsion;
+  paper.keep_speed = p.flag("keep_speed", true);
   p.finish();
-  return std::make_unique<VasarhelyiLaw>(
-      paper, k, scale_given ? std::optional<double>(s) : std::nullopt, d_int, std::move(overrides));
+  return std::make_unique<VasarhelyiLaw>(paper, k, shill_scale,
+                                         scale_given ? std::optional<double>(s) : std::nullopt,
+                                         d_int, std::move(overrides));
 }
 
 }  // namespace ddswarm::agent::laws

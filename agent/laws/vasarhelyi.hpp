@@ -25,23 +25,39 @@
 //                    v_is^shill = C_shill (v_is − v_is^smax) (v_s − v_i) / v_is
 //                                                                  for v_is > v_is^smax
 // then cut to v_max: v_i^d ← v_i^d min(|v_i^d|, v_max) / |v_i^d|, with v_max
-// never above o.max_speed_mps. The paper has no attraction: the alignment
-// term (a friction on velocity differences, allowed to grow with distance
-// along the braking curve) holds the flock together, and the repulsion
-// spaces it at about r0_rep.
+// never above o.max_speed_mps (but see "Speed" below). The paper has no
+// attraction: the alignment term (a friction on velocity differences, allowed
+// to grow with distance along the braking curve) holds the flock together,
+// and the repulsion spaces it at about r0_rep.
 //
 // Self-propulsion in ddswarm. The law's velocity stands for C + V_mission
 // (law.hpp), so when the mission asks a horizontal velocity (task, move,
 // swarm gathering, follow) the self-propulsion term is o.mission_velocity
 // itself, at the mission's speed: the task flies at the speed the scenario
 // configures, and a gathering ends at the goal, whose pull the mission
-// velocity already carries (o.goal_world is not read). With no horizontal
-// mission velocity (hold, landing):
+// velocity already carries (o.goal_world only breaks the slide's ties, below).
+// With no horizontal mission velocity (hold, landing):
 //   self_propulsion = mission (default): no self-propulsion; the drones
 //     hover, spread by the repulsion and calmed by the alignment term.
 //   self_propulsion = heading: the paper's v_flock v_i / |v_i| (nothing
 //     while |v_i| < 1 mm/s), so a flock in hold flies on as in the paper's
 //     free flight; except in landing, where it would carry landing drones off.
+//
+// Speed (keep_speed = true, the default; ddswarm's, after the authors'
+// code). The paper cuts the sum at v_max. The authors' simulation code
+// (robotsim, github.com/csviragh/robotsim, src/algo_spp_evol.c, its "SPP
+// algorithm for testing evolution algorithms") instead sets the sum's length
+// to v_flock every step (the cut at V_Max is the branch it does not take), so
+// there the terms turn a drone and never slow it. Here, while the mission
+// propels horizontally and the sum heads forward (its dot product with the
+// mission velocity is positive), a sum slower than the mission is raised to
+// the mission's speed (at most v_max); a faster one is cut at v_max as in the
+// paper, so the repulsion can still push harder than the mission. A sum
+// heading backward, and any sum without a horizontal mission velocity (hold,
+// landing, free flight), is the paper's. Without it the shill agents' braking
+// (their term grows with the drone's own speed toward them) holds a drone to
+// a crawl at every gap of a pillar field: the thesis course takes 132-138 s
+// instead of 110-114 s (seeds 1-3).
 //
 // Shill agents from rays. A ray hit at horizontal distance S_k in the world
 // direction u_k (from the body yaw and pitch through o.q_world_body) is a
@@ -78,27 +94,74 @@
 // φ_corr 0.95 in 10 s, against 20 of 20 with 85.3 m).
 // With the defaults (D_int 4 m, max speed 3 m/s: s = 0.156, k = 0.75):
 // r0_rep 4 m, p_rep 0.62 /s, r0_frict 85.3 m, v_frict 0.47 m/s, p_frict
-// 2.4 /s, a_frict 2.34 m/s², r0_shill 0.047 m, v_shill 10.2 m/s, p_shill
-// 17.0 /s, a_shill 10.9 m/s². A hovering drone then feels an obstacle from
-// 4.8 m (1.2 r0_rep; the paper's walls act from 31 m at 25.6 m spacing).
-// scale = 1 with v_flock_mps = 4 is the paper's set itself. A parameter given
-// explicitly is used as written, unscaled.
+// 2.4 /s, a_frict 2.34 m/s², r0_shill 0.047 m; the shill agents' speed scale
+// k_s follows the self-propulsion (below): in hold k_s = k, v_shill 10.2 m/s,
+// p_shill 17.0 /s, a_shill 10.9 m/s²; in a task at 0.8 m/s k_s = 0.2,
+// v_shill 2.72 m/s, p_shill 4.55 /s, a_shill 0.77 m/s². Either way a
+// hovering drone feels an obstacle from 4.8 m (1.2 r0_rep; the paper's walls
+// act from 31 m at 25.6 m spacing). scale = 1 with v_flock_mps = 4 is the
+// paper's set itself (with shill_speed = v_flock, or without a mission
+// velocity). A parameter given explicitly is used as written, unscaled.
+//
+// Shill agents' speed (shill_speed = propulsion, the default). The shill
+// agents balance the self-propulsion: the paper's set holds a drone flying at
+// v_flock off a wall. So their speeds, rates and decelerations (v_shill,
+// p_shill, a_shill) take their speed scale from the self-propulsion actually
+// flown, k_s = v_p / 4 m/s, where v_p is the mission's horizontal speed
+// (task, move, follow), in a gathering the larger of it and the last such
+// speed (the gathering's pull fades at the goal; its cruise speed does not),
+// and v_flock without a mission velocity; v_p in [0.1 m/s, v_max]. Their
+// lengths (r0_shill, the reach) do not follow it: under dynamic similarity
+// the reach does not depend on the speed. shill_speed = v_flock scales them with
+// k, as the other terms (the repulsion and the alignment keep k: they space
+// and align drones that the obstacles and each other push at up to v_max).
+// That was the trap on the thesis course: the task flies at 0.8 m/s, but a
+// shill set made for 3 m/s (v_shill 10.2 m/s) pushes a hovering drone off a
+// pillar at up to 10 m/s; in front of a 6 m gap the two pillars' shill
+// agents, 45° to either side, together push it back at the mission's 0.8 m/s
+// 3.4 m short of the row, and it hovers there (6 drones, 200 s: at most 2
+// past the finish). With k_s = 0.2 the same agents push it back at 0.2 m/s.
+// Scaling the repulsion and the alignment with k_s too weakens the repulsion
+// fourfold: drones then come within 0.8-1.4 m of each other on the course
+// (2.2-2.8 m with k).
+//
+// The shill agents' reach (shill_scale, default 1: the paper's). Even so the
+// thesis course is narrow for the paper's set: its gaps are 1.5 r0_rep wide,
+// and the shill agents brake a drone from 4.8 m (1.2 r0_rep) of each pillar,
+// further when it flies at them, so every gap brakes the flock. One drone
+// alone (FlockSim, 0.8 m/s from y = 0) reaches the finish line in 114-116 s
+// when 64 rays see every pillar, 94-97 s with the course's 8 rays (which miss
+// a pillar between them), where the mission's pace is 85 s. shill_scale
+// multiplies the shill set's length scale (r0_shill and the reach ×
+// shill_scale, rates and decelerations ÷ shill_scale), keeping it dynamically
+// similar to itself at a shorter reach: 0.625 (3 m) flies the course in
+// 98-99 s, the default in 110-114 s (seeds 1-5; no contact in either).
 //
 // The slide (ddswarm's, not the paper's; slide = false turns it off). The
 // paper's self-propulsion follows the drone's own velocity, so a drone that
 // the shill agents slow in front of an obstacle turns with them. The
 // mission's direction does not turn: a drone flying it straight at a pillar
-// stops in front of it for good. So, while a shill agent acts (its term is
-// nonzero), the mission propulsion's part into the strongest one's obstacle
-// is turned along the obstacle's tangent, on the side the mission leans to
-// (left when dead centre), keeping the mission's speed.
+// stops in front of it for good. So the part of the mission propulsion that
+// the strongest shill agent cancels, c = min(b, −shill_s · u) with u the
+// direction to its obstacle and b = propulsion · u, is turned along the
+// obstacle's tangent: propulsion − c u + c t. Nothing turns at the edge of
+// the agent's reach; all of b where the agent holds the drone (at the stall).
+// The side t is the one the propulsion leans to. Dead centre (within about
+// 1°, as a pillar seen by a single ray usually is: the ring quantises its
+// direction to the ray spacing), it is the side the slide took within the
+// last 1 s, else the side of the goal (o.goal_world), else left. The memory
+// keeps a drone from turning back and forth across a pillar's front; the
+// goal keeps every pillar from being passed on its left, which walks a flock
+// 4 m sideways per row of a staggered field (with "left" alone the thesis
+// course's flock reaches the finish 11-17 m west of the goal).
 //
 // Peers. Distances and velocities are horizontal (the framework flies the
 // law at one altitude). A peer with a non-finite position is ignored; one
 // without a velocity (NaN) repels but takes no part in the alignment. The
 // command's vertical part is the mission's (o.mission_velocity.z), which the
 // altitude hold replaces when on. The law uses no randomness and handles
-// obstacles itself (uses_obstacle_term() is false).
+// obstacles itself (uses_obstacle_term() is false). Its state: the last
+// cruise speed (shill agents' speed) and the slide's side memory.
 //
 // Parameters (agent.law.params). Default: the paper's value for v_flock =
 // 4 m/s (its Table 1 as SwarmLab, lis-epfl/swarmlab, and other reference
@@ -115,13 +178,16 @@
 //   p_frict      1/s     3.20 k               [0.001, 1000]    3.20
 //   a_frict      m/s²    4.16 k²              [0.001, 1000]    4.16
 //   r0_shill_m   m       0.3 s                [-100, 100]      0.3
-//   v_shill_mps  m/s     13.6 k               [0, 100]         13.6
-//   p_shill      1/s     3.55 k/s             [0.001, 1000]    3.55
-//   a_shill      m/s²    3.02 k²/s            [0.001, 1000]    3.02
+//   v_shill_mps  m/s     13.6 k_s             [0, 100]         13.6
+//   p_shill      1/s     3.55 k_s/s           [0.001, 1000]    3.55
+//   a_shill      m/s²    3.02 k_s²/s          [0.001, 1000]    3.02
 //   c_shill      -       1                    [0, 10]          1 (no coefficient)
 //   self_propulsion  -   mission              mission | heading
 //   shill_agents     -   nearest              nearest | every_ray
 //   slide            -   true                 true | false
+//   shill_speed      -   propulsion           propulsion | v_flock
+//   shill_scale      -   1                    [0.05, 20]       -
+//   keep_speed       -   true                 true | false
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
@@ -141,6 +207,13 @@ inline constexpr double kPaperSpacingM = 25.6;  ///< m, the set's r0_rep: the le
 enum class Propulsion { kMission, kHeading };
 /// Which ray hits stand for shill agents.
 enum class ShillAgents { kNearest, kEveryRay };
+/// Which speed the shill agents are scaled to (see "Shill agents' speed").
+enum class ShillSpeed { kPropulsion, kVFlock };
+
+/// m/s, the slowest self-propulsion the shill agents are scaled to (v_flock's lower bound)
+inline constexpr double kMinPropulsionMps = 0.1;
+/// s, how long the slide keeps a side for a dead-centre obstacle after it last acted
+inline constexpr double kSlideMemoryS = 1.0;
 
 /// The model's parameters in SI units. The defaults are the paper's
 /// optimised set for v_flock = 4 m/s, unscaled.
@@ -161,7 +234,10 @@ struct Config {
   double c_shill = 1.0;       ///< -, shill coefficient (the paper has none: 1)
   Propulsion propulsion = Propulsion::kMission;
   ShillAgents shill_agents = ShillAgents::kNearest;
-  bool slide = true;  ///< turn a blocked mission propulsion along the obstacle (ddswarm's)
+  bool slide = true;       ///< turn a blocked mission propulsion along the obstacle (ddswarm's)
+  bool keep_speed = true;  ///< never slower than the mission while heading forward (ddswarm's)
+  /// Read by the law when it scales the set, not by evaluate().
+  ShillSpeed shill_speed = ShillSpeed::kPropulsion;
 };
 
 /// c made dynamically similar (see "Scaling"): lengths × length_scale,
@@ -170,6 +246,13 @@ struct Config {
 /// scale 1 (r0_frict kept, p_frict × speed_scale, a_frict × speed_scale²);
 /// coefficients, v_flock, v_max and the choices unchanged. Both scales > 0.
 Config scaled(const Config& c, double length_scale, double speed_scale);
+
+/// scaled(c, length_scale, speed_scale), but the shill agents' set
+/// (r0_shill, v_shill, p_shill, a_shill) scaled with the speed scale
+/// shill_speed_scale and the length scale length_scale · shill_scale. All
+/// scales > 0.
+Config scaled(const Config& c, double length_scale, double speed_scale, double shill_speed_scale,
+              double shill_scale = 1.0);
 
 /// D(r, a, p) in m/s: 0 for r ≤ 0 (and NaN r), r p below r = a / p²,
 /// √(2 a r − a² / p²) above. a > 0 (m/s²), p > 0 (1/s), r in m.
@@ -210,15 +293,29 @@ std::vector<ShillAgent> shill_agents(std::span<const law::Ray> rays,
 Eigen::Vector2d self_propulsion(const Eigen::Vector2d& v_i, const Eigen::Vector3d& mission_velocity,
                                 law::Phase phase, const Config& c);
 
-/// The slide: propulsion less its part b = propulsion · toward_obstacle
-/// into the obstacle, plus b along the obstacle's tangent on the side the
-/// propulsion leans to (left of toward_obstacle when dead centre); the
-/// speed is kept. Unchanged when b ≤ 0.
+/// The side the slide turns to: +1 left of toward_obstacle, −1 right; the
+/// side propulsion leans to, or tie (+1 or −1) when it is dead centre
+/// (within about 1°).
+int slide_side(const Eigen::Vector2d& propulsion, const Eigen::Vector2d& toward_obstacle, int tie);
+
+/// The slide: propulsion − c u + c t, with u = toward_obstacle, c = amount
+/// clamped to [0, b], b = propulsion · u (its part into the obstacle), and t
+/// the unit tangent on side (+1 left of u, −1 right). Unchanged when b ≤ 0.
+Eigen::Vector2d slide(const Eigen::Vector2d& propulsion, const Eigen::Vector2d& toward_obstacle,
+                      int side, double amount);
+
+/// The whole slide (amount b) on slide_side(propulsion, toward_obstacle, +1).
 Eigen::Vector2d slide(const Eigen::Vector2d& propulsion, const Eigen::Vector2d& toward_obstacle);
+
+/// What the slide remembers between ticks: the side it last took and when.
+struct SlideMemory {
+  int side = 0;          ///< +1 left of the obstacle, −1 right, 0 none yet
+  double time_s = -1e9;  ///< s, o.sim_time_s when it last acted
+};
 
 /// The terms of one evaluation (m/s, horizontal), for logging and tests.
 struct Terms {
-  Eigen::Vector2d propulsion{0, 0};
+  Eigen::Vector2d propulsion{0, 0};  ///< after the slide
   Eigen::Vector2d repulsion{0, 0};
   Eigen::Vector2d friction{0, 0};
   Eigen::Vector2d shill{0, 0};
@@ -226,7 +323,9 @@ struct Terms {
 };
 
 /// Every term for one drone's observation with parameters c (already scaled).
-Terms evaluate(const law::Observation& o, const Config& c);
+/// memory: the slide's memory, read and updated; nullptr = none (a
+/// dead-centre obstacle then goes by the goal's side, else left).
+Terms evaluate(const law::Observation& o, const Config& c, SlideMemory* memory = nullptr);
 
 }  // namespace vasarhelyi
 

@@ -142,6 +142,32 @@ TEST(VasarhelyiTerms, ShillAgentPushesAwayOnlyWhenTooFastForTheDistance) {
             vasarhelyi::shill(Eigen::Vector2d::Zero(), east, 3.0, c).x());
 }
 
+TEST(VasarhelyiTerms, ShillSpeedScaleTouchesOnlyTheShillSpeedsRatesAndDecelerations) {
+  const Config base = vasarhelyi::scaled(Config{}, 0.5, 0.5);
+  const Config c = vasarhelyi::scaled(Config{}, 0.5, 0.5, 0.25);
+  EXPECT_DOUBLE_EQ(c.v_shill_mps, 13.6 * 0.25);
+  EXPECT_DOUBLE_EQ(c.p_shill, 3.55 * 0.25 / 0.5);
+  EXPECT_DOUBLE_EQ(c.a_shill, 3.02 * 0.25 * 0.25 / 0.5);
+  EXPECT_DOUBLE_EQ(c.r0_shill_m, base.r0_shill_m);  // a length: unchanged
+  EXPECT_DOUBLE_EQ(c.p_rep, base.p_rep);
+  EXPECT_DOUBLE_EQ(c.v_frict_mps, base.v_frict_mps);
+  EXPECT_DOUBLE_EQ(c.a_frict, base.a_frict);
+  // The hovering reach, where D(r − r0_shill) = v_shill, is a length too.
+  const auto reach = [](const Config& k) {
+    return k.r0_shill_m +
+           (k.v_shill_mps * k.v_shill_mps + k.a_shill * k.a_shill / (k.p_shill * k.p_shill)) /
+               (2 * k.a_shill);
+  };
+  EXPECT_NEAR(reach(c), reach(base), 1e-9);
+  // shill_scale shortens the reach and r0_shill alike, nothing else.
+  const Config shorter = vasarhelyi::scaled(Config{}, 0.5, 0.5, 0.25, 0.625);
+  EXPECT_NEAR(reach(shorter), 0.625 * reach(c), 1e-9);
+  EXPECT_DOUBLE_EQ(shorter.r0_shill_m, 0.625 * c.r0_shill_m);
+  EXPECT_DOUBLE_EQ(shorter.v_shill_mps, c.v_shill_mps);
+  EXPECT_DOUBLE_EQ(shorter.p_rep, c.p_rep);
+  EXPECT_DOUBLE_EQ(shorter.r0_rep_m, c.r0_rep_m);
+}
+
 TEST(VasarhelyiTerms, ScaledKeepsTheAlignmentReachAndScalesTheRest) {
   const Config c = vasarhelyi::scaled(Config{}, 0.5, 0.5);
   EXPECT_DOUBLE_EQ(c.r0_rep_m, 12.8);
@@ -212,6 +238,56 @@ TEST(VasarhelyiTerms, SlideTurnsTheBlockedPartAlongTheObstacle) {
   EXPECT_NEAR(leaning_right.x(), 0, 1e-12);
   EXPECT_NEAR(leaning_right.y(), -2, 1e-12);
   EXPECT_EQ(vasarhelyi::slide({-1, 0.5}, east), Eigen::Vector2d(-1, 0.5));  // not blocked
+  // Only the amount given turns (the part the shill agent cancels), at most
+  // the blocked part; the side is the caller's.
+  const Eigen::Vector2d part = vasarhelyi::slide({2, 0}, east, -1, 0.5);
+  EXPECT_NEAR(part.x(), 1.5, 1e-12);
+  EXPECT_NEAR(part.y(), -0.5, 1e-12);
+  EXPECT_EQ(vasarhelyi::slide({2, 0}, east, 1, 0.0), Eigen::Vector2d(2, 0));
+  const Eigen::Vector2d capped = vasarhelyi::slide({2, 0}, east, 1, 9.0);
+  EXPECT_NEAR(capped.x(), 0, 1e-12);
+  EXPECT_NEAR(capped.y(), 2, 1e-12);
+}
+
+TEST(VasarhelyiTerms, SlideSideIsTheLeanOrTheTieWhenDeadCentre) {
+  const Eigen::Vector2d north(0, 1);
+  EXPECT_EQ(vasarhelyi::slide_side({-0.1, 1}, north, -1), 1);  // leans left (west)
+  EXPECT_EQ(vasarhelyi::slide_side({0.1, 1}, north, 1), -1);   // leans right
+  EXPECT_EQ(vasarhelyi::slide_side({0, 1}, north, -1), -1);    // dead centre: the tie
+  EXPECT_EQ(vasarhelyi::slide_side({0.01, 1}, north, 1), 1);   // within 1°: still a tie
+  // A ray at 90° gives cos(π/2) ≈ 6e-17, not 0: still dead centre.
+  const Eigen::Vector2d ray(std::cos(std::numbers::pi / 2), std::sin(std::numbers::pi / 2));
+  EXPECT_EQ(vasarhelyi::slide_side({0, 0.8}, ray, -1), -1);
+}
+
+TEST(VasarhelyiTerms, KeepSpeedRaisesAForwardSumToTheMissionSpeedOnly) {
+  // A peer 2 m ahead repels at p_rep (r0 − 2 m): the sum still heads
+  // forward, slower than the mission; keep_speed raises it to the mission's.
+  Config c;
+  c.r0_rep_m = 4;
+  c.p_rep = 0.3;  // 0.6 m/s back
+  const std::vector<law::Peer> ahead{{1, Eigen::Vector3d(0, 2, 0), Eigen::Vector3d(0, 0.8, 0), 0}};
+  law::Observation o;
+  o.peers = ahead;
+  o.phase = law::Phase::kTask;
+  o.mission_velocity = Eigen::Vector3d(0, 0.8, 0);
+  o.max_speed_mps = 3;
+  o.v_world = Eigen::Vector3d(0, 0.8, 0);
+  const Eigen::Vector2d kept = vasarhelyi::evaluate(o, c).velocity;
+  EXPECT_NEAR(kept.x(), 0, 1e-12);
+  EXPECT_NEAR(kept.y(), 0.8, 1e-12);
+  c.keep_speed = false;
+  EXPECT_NEAR(vasarhelyi::evaluate(o, c).velocity.y(), 0.2, 1e-12);
+  // Heading backward (the peer 1 m ahead: 0.9 m/s back): the paper's sum.
+  c.keep_speed = true;
+  const std::vector<law::Peer> close{{1, Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0.8, 0), 0}};
+  o.peers = close;
+  EXPECT_NEAR(vasarhelyi::evaluate(o, c).velocity.y(), -0.1, 1e-12);
+  // Without a horizontal mission velocity nothing is raised.
+  o.phase = law::Phase::kHold;
+  o.mission_velocity.setZero();
+  o.peers = ahead;
+  EXPECT_NEAR(vasarhelyi::evaluate(o, c).velocity.y(), -0.6, 1e-12);
 }
 
 // --- The law in a flock -----------------------------------------------------
@@ -278,22 +354,96 @@ TEST(VasarhelyiFlock, PassesAPillarWithoutTouchingIt) {
   }
 }
 
-TEST(VasarhelyiFlock, WithoutTheSlideADroneInLineStopsAtThePillar) {
-  // The paper's terms alone: the middle row meets the pillar dead centre,
-  // the shill agent cancels the mission and that drone stays in front.
+TEST(VasarhelyiFlock, WithoutTheSlideADroneDeadCentreStopsAtThePillar) {
+  // The paper's terms alone: a drone flying the task straight at a pillar
+  // stops where its shill agent cancels the mission, and stays there (2.4 m
+  // from the surface; keep_speed does not push a backward sum on). With the
+  // slide it goes around.
+  for (bool slide : {false, true}) {
+    FlockSim sim;
+    sim.rays = 16;
+    sim.ray_range_m = 8;
+    sim.pillars.push_back({Eigen::Vector2d(20, 0), 0.5});
+    sim.phase = law::Phase::kTask;
+    sim.mission_velocity = Eigen::Vector3d(1.5, 0, 0);
+    sim.add(build({{"slide", slide ? "true" : "false"}}), 0, 0);
+    sim.run(40.0);
+    EXPECT_GT(sim.min_clearance_seen_m, 1.0) << "slide " << slide;
+    if (slide) {
+      EXPECT_GT(sim.drones[0].p.x(), 40.0);
+    } else {
+      EXPECT_LT(sim.drones[0].p.x(), 20.0 - 0.5 - 1.0);
+      EXPECT_LT(sim.drones[0].v.norm(), 0.05);
+    }
+  }
+}
+
+/// The thesis course's first row in small: two pillars of radius 1 m, 8 m
+/// apart (a 6 m gap) with their centres at y = 20, the task north at 0.8 m/s,
+/// the course's ring of 8 rays of 6 m; drones abreast at y = 0.
+FlockSim pillar_gap(const std::vector<double>& xs, std::map<std::string, std::string> params) {
   FlockSim sim;
-  sim.rays = 16;
-  sim.ray_range_m = 8;
-  sim.pillars.push_back({Eigen::Vector2d(20, 0), 0.5});
+  sim.rays = 8;
+  sim.ray_range_m = 6;
+  sim.pillars.push_back({Eigen::Vector2d(-4, 20), 1.0});
+  sim.pillars.push_back({Eigen::Vector2d(4, 20), 1.0});
   sim.phase = law::Phase::kTask;
-  sim.mission_velocity = Eigen::Vector3d(1.5, 0, 0);
-  for (int row = -1; row <= 1; ++row)
-    for (int col = 0; col < 3; ++col) sim.add(build({{"slide", "false"}}), 4.0 * col, 4.0 * row);
-  sim.run(40.0);
-  EXPECT_GT(sim.min_clearance_seen_m, 1.0);
-  double behind = 0;
-  for (const auto& d : sim.drones) behind += d.p.x() < 20.0 ? 1 : 0;
-  EXPECT_GE(behind, 1);
+  sim.mission_velocity = Eigen::Vector3d(0, 0.8, 0);
+  for (double x : xs) sim.add(build(params), x, 0);
+  return sim;
+}
+
+TEST(VasarhelyiFlock, ShillAgentsScaledToTheMissionSpeedLetTheFlockThroughAGap) {
+  // The trap the thesis course showed (6 drones, 2 past the finish in 200 s):
+  // with the shill agents scaled to v_flock (3 m/s: v_shill 10.2 m/s) while
+  // the mission propels at 0.8 m/s, the two pillars' agents, seen 45° to
+  // either side, together push a drone on the gap's centre line back at the
+  // mission's speed 3.4 m short of the row, and it hovers there for good.
+  FlockSim trapped = pillar_gap({0.0}, {{"shill_speed", "v_flock"}});
+  trapped.run(60.0);
+  EXPECT_LT(trapped.drones[0].p.y(), 17.0);
+  EXPECT_LT(trapped.drones[0].v.norm(), 0.05);
+
+  // Scaled to the mission's 0.8 m/s (the default), one drone and three
+  // abreast, 2 m apart, are through in 60 s; none comes within 1 m of a
+  // pillar's surface or of another drone (measured: clearance 3.0 m alone,
+  // 1.6 m three abreast; closest pair 1.9 m).
+  for (const auto& xs : {std::vector<double>{0.0}, std::vector<double>{-2.0, 0.0, 2.0}}) {
+    FlockSim sim = pillar_gap(xs, {});
+    sim.run(60.0);
+    for (const auto& d : sim.drones) EXPECT_GT(d.p.y(), 30.0) << xs.size() << " abreast";
+    EXPECT_GT(sim.min_clearance_seen_m, 1.0) << xs.size() << " abreast";
+    EXPECT_GT(sim.min_distance_seen_m, 1.0) << xs.size() << " abreast";
+  }
+}
+
+TEST(VasarhelyiFlock, ADroneDeadCentreOnAPillarGoesAroundOnTheGoalsSide) {
+  // A pillar straight ahead is seen by one ray only, so the mission is dead
+  // centre on it: the slide turns to the goal's side (with no goal, left),
+  // and keeps that side while it passes (no dithering across its front).
+  struct Case {
+    double goal_x;  // NaN: no goal
+    double side;    // +1 east, -1 west
+  };
+  for (const Case& k : {Case{15.0, 1}, Case{-15.0, -1}, Case{NAN, -1}}) {
+    FlockSim sim;
+    sim.rays = 8;
+    sim.ray_range_m = 6;
+    sim.pillars.push_back({Eigen::Vector2d(0, 10), 1.0});
+    sim.phase = law::Phase::kTask;
+    sim.mission_velocity = Eigen::Vector3d(0, 0.8, 0);
+    sim.goal = Eigen::Vector3d(k.goal_x, 40, 2);
+    sim.add(build({}), 0, 0);
+    double x_abeam = 0;  // x where the drone draws level with the pillar
+    for (int tick = 0; tick < 3000 && sim.drones[0].p.y() < 10; ++tick) {
+      sim.step();
+      x_abeam = sim.drones[0].p.x();
+    }
+    EXPECT_GT(k.side * x_abeam, 1.0) << "goal x " << k.goal_x;
+    sim.run(20.0);
+    EXPECT_GT(sim.drones[0].p.y(), 20.0) << "goal x " << k.goal_x;
+    EXPECT_GT(sim.min_clearance_seen_m, 1.0) << "goal x " << k.goal_x;
+  }
 }
 
 TEST(VasarhelyiFlock, FliesTheMissionVelocityAndHoversWithoutOne) {
@@ -358,6 +508,43 @@ TEST(VasarhelyiLaw, FollowsDIntAndCutsToTheSpeedLimit) {
   EXPECT_EQ(v.z(), -0.5);
 }
 
+TEST(VasarhelyiLaw, ScalesItsShillAgentsToTheSpeedTheMissionFlies) {
+  // A wall 2 m west, beside a drone flying the task north: no slide (nothing
+  // blocks the mission), so the command is the terms' sum with the shill set
+  // at k_s = v_p / 4 m/s: 0.2 for the task's 0.8 m/s; in the gathering after
+  // it, still 0.2 though the goal's pull has faded to 0.1 m/s; in hold, k.
+  auto law = build({});
+  Config paper;  // the law's unscaled set at max speed 3 m/s
+  paper.v_flock_mps = 3;
+  paper.v_max_mps = 3;
+  const double s = 4.0 / 25.6, k = 0.75;
+  const std::vector<law::Ray> west = ring(8, 6, {{4, 2.0}});
+  const std::vector<law::Peer> none;
+  law::Observation o = lone_drone(none);
+  o.rays = west;
+  o.v_world = Eigen::Vector3d(0, 0.8, 0);
+  const auto expect_k_shill = [&](double k_shill, const char* what) {
+    const Eigen::Vector2d want =
+        vasarhelyi::evaluate(o, vasarhelyi::scaled(paper, s, k, k_shill)).velocity;
+    EXPECT_GT(want.x(), 0.05) << what << ": the wall pushes east";
+    EXPECT_EQ(law->step(o).velocity_world.head<2>(), want) << what;
+  };
+  o.phase = law::Phase::kTask;
+  o.mission_velocity = Eigen::Vector3d(0, 0.8, 0);
+  expect_k_shill(0.2, "task");
+  o.phase = law::Phase::kSwarm;
+  o.mission_velocity = Eigen::Vector3d(0, 0.1, 0);
+  expect_k_shill(0.2, "gathering");
+  o.phase = law::Phase::kHold;
+  o.mission_velocity.setZero();
+  expect_k_shill(k, "hold");
+  // shill_speed = v_flock: k throughout.
+  law = build({{"shill_speed", "v_flock"}});
+  o.phase = law::Phase::kTask;
+  o.mission_velocity = Eigen::Vector3d(0, 0.8, 0);
+  expect_k_shill(k, "task, shill_speed v_flock");
+}
+
 TEST(VasarhelyiLaw, PeerWithoutVelocityRepelsButDoesNotAlign) {
   auto law = build({});
   const std::vector<law::Peer> peers{
@@ -412,7 +599,10 @@ TEST(VasarhelyiParams, AValidSetBuilds) {
                    {"c_shill", "1"},
                    {"self_propulsion", "heading"},
                    {"shill_agents", "every_ray"},
-                   {"slide", "false"}}),
+                   {"slide", "false"},
+                   {"shill_speed", "v_flock"},
+                   {"shill_scale", "0.5"},
+                   {"keep_speed", "false"}}),
             nullptr);
 }
 
@@ -427,6 +617,9 @@ TEST(VasarhelyiParams, OutOfRangeValuesNameTheirField) {
   EXPECT_EQ(error_for({{"c_frict", "-1"}}).field(), "agent.law.params.c_frict");
   EXPECT_EQ(error_for({{"scale", "abc"}}).field(), "agent.law.params.scale");
   EXPECT_EQ(error_for({{"shill_agents", "all"}}).field(), "agent.law.params.shill_agents");
+  EXPECT_EQ(error_for({{"shill_speed", "mission"}}).field(), "agent.law.params.shill_speed");
+  EXPECT_EQ(error_for({{"keep_speed", "yes"}}).field(), "agent.law.params.keep_speed");
+  EXPECT_EQ(error_for({{"shill_scale", "0"}}).field(), "agent.law.params.shill_scale");
   // Cross-field: the self-propulsion speed cannot exceed the cut-off.
   const law::ParamError e = error_for({{"v_flock_mps", "5"}});  // v_max: max speed 3
   EXPECT_EQ(e.field(), "agent.law.params.v_flock_mps");
