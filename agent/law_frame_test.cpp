@@ -64,8 +64,10 @@ struct Tick {
     in.swarm_horizontal_only = g() % 4 == 0;
     in.altitude_hold = !in.swarm_horizontal_only && g() % 3 != 0;
     in.altitude_target_m = 2 + u(g);
-    for (std::size_t j = 0; j < peers.size(); ++j) law_peers.push_back({static_cast<int>(j + 1), peers[j], {0, 0, 0}, 0});
-    for (std::size_t k = 0; k < range.size(); ++k) law_rays.push_back({range[k], hit[k] != 0, yaw[k], 0});
+    for (std::size_t j = 0; j < peers.size(); ++j)
+      law_peers.push_back({static_cast<int>(j + 1), peers[j], {0, 0, 0}, 0});
+    for (std::size_t k = 0; k < range.size(); ++k)
+      law_rays.push_back({range[k], hit[k] != 0, yaw[k], 0});
     o.p_world = in.p_world;
     o.q_world_body = in.q_world_body;
     o.peers = law_peers;
@@ -182,7 +184,8 @@ TEST(LawFrame, EveryBuiltInLawBuildsWithItsDefaultsAndAnswersFinitely) {
   std::mt19937_64 g(5);
   AgentConfig c;
   law::LawContext ctx;
-  for (auto type : {LawType::kThesis, LawType::kReynolds, LawType::kOlfatiSaber, LawType::kVasarhelyi}) {
+  for (auto type :
+       {LawType::kThesis, LawType::kReynolds, LawType::kOlfatiSaber, LawType::kVasarhelyi}) {
     LawConfig lc;
     lc.type = type;
     EXPECT_NO_THROW(lc.validate()) << to_string(type);

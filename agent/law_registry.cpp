@@ -25,7 +25,8 @@ class ThesisLaw final : public law::SwarmLaw {
   law::Command step(const law::Observation& o) override {
     positions_.clear();
     for (const auto& p : o.peers) positions_.push_back(p.p_world);
-    Eigen::Vector3d swarm = repulsion_attraction(o.p_world, positions_, o.inter_distance_m, activation_);
+    Eigen::Vector3d swarm =
+        repulsion_attraction(o.p_world, positions_, o.inter_distance_m, activation_);
     if (o.phase == law::Phase::kLanding) swarm.z() = 0;
     return {swarm + o.mission_velocity, 0.0};
   }
@@ -116,7 +117,8 @@ std::unique_ptr<law::SwarmLaw> make_law(const LawConfig& c, const law::LawContex
   }
   p.finish();
   if (c.obstacles != LawConfig::Obstacles::kAuto)
-    l = std::make_unique<ObstaclesBy>(std::move(l), c.obstacles == LawConfig::Obstacles::kFramework);
+    l = std::make_unique<ObstaclesBy>(std::move(l),
+                                      c.obstacles == LawConfig::Obstacles::kFramework);
   if (c.fault != LawConfig::Fault::kNone)
     l = std::make_unique<FaultyLaw>(std::move(l), c.fault, c.fault_after_s);
   return l;
@@ -131,7 +133,8 @@ std::string python_law_plugin() {
 }
 
 std::uint64_t law_seed(std::uint64_t scenario_seed, int drone_id) {
-  return scenario_seed * 0x9e3779b97f4a7c15ULL ^ (0x1a3ULL << 32) ^ static_cast<std::uint64_t>(drone_id);
+  return scenario_seed * 0x9e3779b97f4a7c15ULL ^ (0x1a3ULL << 32) ^
+         static_cast<std::uint64_t>(drone_id);
 }
 
 }  // namespace ddswarm::agent

@@ -21,12 +21,12 @@ struct Pillar {
 
 class FlockSim {
  public:
-  double dt_s = 0.02;            ///< s, control period
-  double response_s = 0.3;       ///< s, velocity-loop time constant
-  double max_speed_mps = 3.0;    ///< m/s, command limit (the framework's)
-  double z_m = 2.0;              ///< m, every drone's altitude
-  int rays = 0;                  ///< rays in the ring, 0 = no sensors
-  double ray_range_m = 10.0;     ///< m, sensor range
+  double dt_s = 0.02;          ///< s, control period
+  double response_s = 0.3;     ///< s, velocity-loop time constant
+  double max_speed_mps = 3.0;  ///< m/s, command limit (the framework's)
+  double z_m = 2.0;            ///< m, every drone's altitude
+  int rays = 0;                ///< rays in the ring, 0 = no sensors
+  double ray_range_m = 10.0;   ///< m, sensor range
   std::vector<Pillar> pillars;
   Eigen::Vector3d mission_velocity{0, 0, 0};  ///< m/s
   Eigen::Vector3d goal{NAN, NAN, NAN};

@@ -30,7 +30,9 @@ namespace {
 /// its peers and rays, so a law may keep it past the call.
 struct PyObservation {
   explicit PyObservation(const Observation& obs)
-      : o(obs), peer_list(obs.peers.begin(), obs.peers.end()), ray_list(obs.rays.begin(), obs.rays.end()) {
+      : o(obs),
+        peer_list(obs.peers.begin(), obs.peers.end()),
+        ray_list(obs.rays.begin(), obs.rays.end()) {
     o.peers = peer_list;
     o.rays = ray_list;
   }
@@ -49,7 +51,8 @@ struct PyObservation {
     auto m = a.mutable_unchecked<2>();
     for (std::size_t i = 0; i < o.peers.size(); ++i)
       for (int k = 0; k < 3; ++k)
-        m(static_cast<py::ssize_t>(i), k) = what == 0 ? o.peers[i].p_world[k] : o.peers[i].v_world[k];
+        m(static_cast<py::ssize_t>(i), k) =
+            what == 0 ? o.peers[i].p_world[k] : o.peers[i].v_world[k];
     return a;
   }
   template <class F>
@@ -79,35 +82,50 @@ PYBIND11_EMBEDDED_MODULE(ddswarm_law, m) {
       .def_property_readonly("dt_s", [](const PyObservation& s) { return s.o.dt_s; })
       .def_property_readonly("p", [](const PyObservation& s) { return s.vec(s.o.p_world); })
       .def_property_readonly("v", [](const PyObservation& s) { return s.vec(s.o.v_world); })
-      .def_property_readonly("q", [](const PyObservation& s) {  // w, x, y, z
-        py::array_t<double> a(4);
-        auto m = a.mutable_unchecked<1>();
-        m(0) = s.o.q_world_body.w(), m(1) = s.o.q_world_body.x();
-        m(2) = s.o.q_world_body.y(), m(3) = s.o.q_world_body.z();
-        return a;
-      })
-      .def_property_readonly("peers_id", [](const PyObservation& s) {
-        return s.per_peer([](const Peer& p) { return static_cast<double>(p.id); });
-      })
+      .def_property_readonly("q",
+                             [](const PyObservation& s) {  // w, x, y, z
+                               py::array_t<double> a(4);
+                               auto m = a.mutable_unchecked<1>();
+                               m(0) = s.o.q_world_body.w(), m(1) = s.o.q_world_body.x();
+                               m(2) = s.o.q_world_body.y(), m(3) = s.o.q_world_body.z();
+                               return a;
+                             })
+      .def_property_readonly(
+          "peers_id",
+          [](const PyObservation& s) {
+            return s.per_peer([](const Peer& p) { return static_cast<double>(p.id); });
+          })
       .def_property_readonly("peers_p", [](const PyObservation& s) { return s.peers(0); })
       .def_property_readonly("peers_v", [](const PyObservation& s) { return s.peers(1); })
-      .def_property_readonly("peers_age_s",
-                             [](const PyObservation& s) { return s.per_peer([](const Peer& p) { return p.age_s; }); })
-      .def_property_readonly("rays_range_m",
-                             [](const PyObservation& s) { return s.per_ray([](const Ray& r) { return r.range_m; }); })
-      .def_property_readonly("rays_hit", [](const PyObservation& s) {
-        return s.per_ray([](const Ray& r) { return r.hit ? 1.0 : 0.0; });
-      })
+      .def_property_readonly(
+          "peers_age_s",
+          [](const PyObservation& s) { return s.per_peer([](const Peer& p) { return p.age_s; }); })
+      .def_property_readonly(
+          "rays_range_m",
+          [](const PyObservation& s) { return s.per_ray([](const Ray& r) { return r.range_m; }); })
+      .def_property_readonly("rays_hit",
+                             [](const PyObservation& s) {
+                               return s.per_ray([](const Ray& r) { return r.hit ? 1.0 : 0.0; });
+                             })
       .def_property_readonly("rays_yaw_rad",
-                             [](const PyObservation& s) { return s.per_ray([](const Ray& r) { return r.yaw_body_rad; }); })
+                             [](const PyObservation& s) {
+                               return s.per_ray([](const Ray& r) { return r.yaw_body_rad; });
+                             })
       .def_property_readonly("rays_pitch_rad",
-                             [](const PyObservation& s) { return s.per_ray([](const Ray& r) { return r.pitch_body_rad; }); })
-      .def_property_readonly("phase", [](const PyObservation& s) { return static_cast<int>(s.o.phase); })
-      .def_property_readonly("mission_velocity", [](const PyObservation& s) { return s.vec(s.o.mission_velocity); })
+                             [](const PyObservation& s) {
+                               return s.per_ray([](const Ray& r) { return r.pitch_body_rad; });
+                             })
+      .def_property_readonly("phase",
+                             [](const PyObservation& s) { return static_cast<int>(s.o.phase); })
+      .def_property_readonly("mission_velocity",
+                             [](const PyObservation& s) { return s.vec(s.o.mission_velocity); })
       .def_property_readonly("goal", [](const PyObservation& s) { return s.vec(s.o.goal_world); })
-      .def_property_readonly("inter_distance_m", [](const PyObservation& s) { return s.o.inter_distance_m; })
-      .def_property_readonly("altitude_target_m", [](const PyObservation& s) { return s.o.altitude_target_m; })
-      .def_property_readonly("max_speed_mps", [](const PyObservation& s) { return s.o.max_speed_mps; });
+      .def_property_readonly("inter_distance_m",
+                             [](const PyObservation& s) { return s.o.inter_distance_m; })
+      .def_property_readonly("altitude_target_m",
+                             [](const PyObservation& s) { return s.o.altitude_target_m; })
+      .def_property_readonly("max_speed_mps",
+                             [](const PyObservation& s) { return s.o.max_speed_mps; });
 }
 
 namespace {
@@ -127,7 +145,8 @@ void start_python() {
 }
 
 /// A Python exception as one line for the fault, and in full (traceback) on stderr.
-std::string python_error(py::error_already_set& e, const std::string& where, bool traceback = true) {
+std::string python_error(py::error_already_set& e, const std::string& where,
+                         bool traceback = true) {
   if (traceback) {
     std::fprintf(stderr, "ddswarm python law: %s: %s\n", where.c_str(), e.what());
     std::fflush(stderr);
@@ -158,7 +177,8 @@ class PythonLaw final : public SwarmLaw {
       }
       auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(v);
       if (!a || a.size() != 3)
-        throw std::runtime_error(name_ + ".step returned " + py::str(py::repr(r)).cast<std::string>() +
+        throw std::runtime_error(name_ + ".step returned " +
+                                 py::str(py::repr(r)).cast<std::string>() +
                                  ", not a velocity of 3 numbers (or (velocity, yaw_rate))");
       return {Eigen::Vector3d(a.at(0), a.at(1), a.at(2)), yaw};
     } catch (py::error_already_set& e) {
@@ -180,10 +200,13 @@ std::unique_ptr<SwarmLaw> make(Params& p, Rng rng, const LawContext& ctx) {
   if (prefix.size() > 7 && prefix.ends_with(".params")) prefix.resize(prefix.size() - 7);
   const std::string file = p.text("ddswarm:module", "");
   const std::string cls = p.text("ddswarm:class", "");
-  if (file.empty()) throw ParamError(prefix + ".module", "\"\"", "a Python law needs the path of its .py file");
-  if (cls.empty()) throw ParamError(prefix + ".class", "\"\"", "a Python law needs the name of its class");
+  if (file.empty())
+    throw ParamError(prefix + ".module", "\"\"", "a Python law needs the path of its .py file");
+  if (cls.empty())
+    throw ParamError(prefix + ".class", "\"\"", "a Python law needs the name of its class");
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw ParamError(prefix + ".module", file, "no such file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw ParamError(prefix + ".module", file, "no such file");
   start_python();
   py::gil_scoped_acquire gil;
   const std::string where = file + ":" + cls;
@@ -233,7 +256,8 @@ std::unique_ptr<SwarmLaw> make(Params& p, Rng rng, const LawContext& ctx) {
     context["max_speed_mps"] = ctx.max_speed_mps;
     context["control_period_s"] = ctx.control_period_s;
     py::object obj = klass(params, rng.next(), context);
-    if (!py::hasattr(obj, "step")) throw ParamError(prefix + ".class", cls, "has no step(self, obs) method");
+    if (!py::hasattr(obj, "step"))
+      throw ParamError(prefix + ".class", cls, "has no step(self, obs) method");
     const bool obstacle_term =
         py::hasattr(obj, "uses_obstacle_term") ? obj.attr("uses_obstacle_term").cast<bool>() : true;
     return std::make_unique<PythonLaw>(std::move(obj), obstacle_term, cls);

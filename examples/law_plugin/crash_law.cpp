@@ -1,9 +1,8 @@
 // A law that breaks its process on purpose (a segmentation fault) from
 // crash_after_s of sim time on, for testing that a crashing plug-in takes
 // down its own drone only: the server's failsafe lands it, the others fly on.
-#include <ddswarm/law.hpp>
-
 #include <csignal>
+#include <ddswarm/law.hpp>
 
 namespace {
 

@@ -28,7 +28,7 @@ class SpringLaw final : public SwarmLaw {
 };
 
 std::unique_ptr<SwarmLaw> make(Params& p, Rng, const LawContext& ctx) {
-  const double gain = p.number("gain", 0.4, 0.0, 10.0);            // 1/s
+  const double gain = p.number("gain", 0.4, 0.0, 10.0);                                 // 1/s
   const double radius = p.number("radius_m", 3.0 * ctx.inter_distance_m, 0.1, 1000.0);  // m
   return std::make_unique<SpringLaw>(gain, radius);
 }

@@ -60,9 +60,9 @@ struct Peer {
 
 /// One distance-sensor ray.
 struct Ray {
-  double range_m = 0;       ///< m, distance to the hit; meaningless when !hit
-  bool hit = false;         ///< an obstacle within the sensor's range
-  double yaw_body_rad = 0;  ///< rad, about body +z from body +x
+  double range_m = 0;         ///< m, distance to the hit; meaningless when !hit
+  bool hit = false;           ///< an obstacle within the sensor's range
+  double yaw_body_rad = 0;    ///< rad, about body +z from body +x
   double pitch_body_rad = 0;  ///< rad, up from the body's horizontal plane (0: the thesis's ring)
 };
 
@@ -72,8 +72,8 @@ enum class Phase : std::uint8_t {
   kTakeoff = 1,
   kHold = 2,
   kMove = 3,
-  kTask = 4,     ///< flying the thesis task toward the finish line
-  kSwarm = 5,    ///< task: past the finish line, gathering at the goal
+  kTask = 4,   ///< flying the thesis task toward the finish line
+  kSwarm = 5,  ///< task: past the finish line, gathering at the goal
   kFollow = 6,
   kLanding = 7,
   kFailsafe = 8,
@@ -86,8 +86,9 @@ struct Observation {
   double sim_time_s = 0;   ///< s, simulation time of the sample
   double dt_s = 0.02;      ///< s, control period
 
-  Eigen::Vector3d p_world{0, 0, 0};  ///< m, own position as this drone knows it (noisy with comm noise)
-  Eigen::Vector3d v_world{0, 0, 0};  ///< m/s, own velocity
+  Eigen::Vector3d p_world{0, 0,
+                          0};  ///< m, own position as this drone knows it (noisy with comm noise)
+  Eigen::Vector3d v_world{0, 0, 0};                                  ///< m/s, own velocity
   Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();  ///< own attitude
 
   std::span<const Peer> peers;  ///< the peers this drone hears now (self excluded); may be empty
@@ -139,8 +140,7 @@ class Params {
   bool has(const std::string& key) const { return values_.count(key) != 0; }
 
   /// A real number in [lo, hi]; def when absent. Throws ParamError.
-  double number(const std::string& key, double def, double lo = -HUGE_VAL,
-                double hi = HUGE_VAL) {
+  double number(const std::string& key, double def, double lo = -HUGE_VAL, double hi = HUGE_VAL) {
     const std::string* text = take(key);
     if (!text) return def;
     std::size_t used = 0;
@@ -211,7 +211,8 @@ class Params {
       if (read_.count(key)) continue;
       std::string known;
       auto add = [&](const std::string& k) {
-        if (k.rfind("ddswarm:", 0) != 0) known += (known.empty() ? "" : ", ") + k;  // the framework's own
+        if (k.rfind("ddswarm:", 0) != 0)
+          known += (known.empty() ? "" : ", ") + k;  // the framework's own
       };
       for (const auto& k : read_) add(k);
       for (const auto& k : asked_)
@@ -307,9 +308,9 @@ class SwarmLaw {
 /// What a law is built from.
 struct LawContext {
   int drone_id = -1;
-  int num_drones = 0;            ///< drones in the scenario
-  double inter_distance_m = 4.0; ///< m, agent.inter_distance_m (D_int at start)
-  double max_speed_mps = 3.0;    ///< m/s, agent.max_speed_mps
+  int num_drones = 0;              ///< drones in the scenario
+  double inter_distance_m = 4.0;   ///< m, agent.inter_distance_m (D_int at start)
+  double max_speed_mps = 3.0;      ///< m/s, agent.max_speed_mps
   double control_period_s = 0.02;  ///< s, the server's control period
 };
 
@@ -328,10 +329,11 @@ using MakeLaw = std::unique_ptr<SwarmLaw> (*)(Params& p, Rng rng, const LawConte
 ///
 /// The agent checks ddswarm_law_api_version against its own kApiVersion and
 /// refuses a plug-in built against another.
-#define DDSWARM_LAW_PLUGIN(make_fn)                                                           \
-  extern "C" __attribute__((visibility("default"))) int ddswarm_law_api_version() {          \
-    return ::ddswarm::law::kApiVersion;                                                       \
-  }                                                                                           \
-  extern "C" __attribute__((visibility("default"))) ::ddswarm::law::MakeLaw ddswarm_law_factory() { \
-    return &(make_fn);                                                                        \
+#define DDSWARM_LAW_PLUGIN(make_fn)                                                 \
+  extern "C" __attribute__((visibility("default"))) int ddswarm_law_api_version() { \
+    return ::ddswarm::law::kApiVersion;                                             \
+  }                                                                                 \
+  extern "C" __attribute__((visibility("default"))) ::ddswarm::law::MakeLaw         \
+  ddswarm_law_factory() {                                                           \
+    return &(make_fn);                                                              \
   }
