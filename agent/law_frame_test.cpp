@@ -78,6 +78,20 @@ struct Tick {
   }
 };
 
+/// A drone hovering at 2 m whose one ray hits a pillar 1.5 m ahead (+x).
+struct PillarAhead {
+  std::vector<float> range{1.5f}, yaw{0.0f};
+  std::vector<std::uint8_t> hit{1};
+  LawInput in;
+  PillarAhead() {
+    in.p_world = {0, 0, 2};
+    in.altitude_target_m = 2;
+    in.ray_range_m = range;
+    in.ray_hit = hit;
+    in.ray_yaw_body_rad = yaw;
+  }
+};
+
 }  // namespace
 
 // Table 1 stays the same to the last digit: the thesis's law asked through
@@ -118,14 +132,8 @@ TEST(LawFrame, TheLawIsAskedOnlyWhileTheSwarmFlies) {
 }
 
 TEST(LawFrame, ALawThatOptsOutOfTheObstacleTermIsNotPushedByIt) {
-  LawInput in;
-  in.p_world = {0, 0, 2};
-  in.altitude_target_m = 2;
-  const std::vector<float> range{1.5f}, yaw{0.0f};
-  const std::vector<std::uint8_t> hit{1};
-  in.ray_range_m = range;
-  in.ray_hit = hit;
-  in.ray_yaw_body_rad = yaw;
+  PillarAhead ahead;
+  LawInput& in = ahead.in;
   AgentConfig c;
   FixedLaw keeps({0, 0.5, 0}, true), own({0, 0.5, 0}, false);
   const Eigen::Vector3d pushed = step_law(&keeps, {}, in, c).terms.velocity;
@@ -212,14 +220,8 @@ TEST(LawFrame, ALawsSeedDependsOnTheScenarioSeedAndTheDroneAlone) {
 TEST(LawFrame, ObstaclesCanBeLeftToTheFrameworkOrToTheLaw) {
   // A pillar 1.5 m ahead: the framework's fs1 pushes back; a law of its own
   // sees the ray unless the framework takes obstacles over.
-  LawInput in;
-  in.p_world = {0, 0, 2};
-  in.altitude_target_m = 2;
-  const std::vector<float> range{1.5f}, yaw{0.0f};
-  const std::vector<std::uint8_t> hit{1};
-  in.ray_range_m = range;
-  in.ray_hit = hit;
-  in.ray_yaw_body_rad = yaw;
+  PillarAhead ahead;
+  LawInput& in = ahead.in;
   const std::vector<law::Ray> rays{{1.5, true, 0.0, 0.0}};
   law::Observation o;
   o.p_world = in.p_world;

@@ -564,6 +564,26 @@ std::vector<SetSummary> summarize(const std::vector<RunRecord>& records) {
   return out;
 }
 
+
+namespace {
+/// A Markdown table: one column per set, one row per (label, cell of a set).
+std::string sets_table(const std::vector<SetSummary>& sets,
+                       const std::vector<std::pair<std::string, std::function<std::string(const SetSummary&)>>>& rows) {
+  std::ostringstream os;
+  os << "| |";
+  for (const auto& s : sets) os << ' ' << md_cell(s.name) << " |";
+  os << "\n|---|";
+  for (std::size_t i = 0; i < sets.size(); ++i) os << "---|";
+  os << '\n';
+  for (const auto& [label, cell] : rows) {
+    os << "| " << label << " |";
+    for (const auto& s : sets) os << ' ' << cell(s) << " |";
+    os << '\n';
+  }
+  return os.str();
+}
+}  // namespace
+
 std::string markdown_table(const std::vector<SetSummary>& sets) {
   bool any_mixed = false;
   auto setting = [&](const SetSummary& s, std::string text) {
@@ -590,16 +610,7 @@ std::string markdown_table(const std::vector<SetSummary>& sets) {
        }}};
 
   std::ostringstream os;
-  os << "| |";
-  for (const auto& s : sets) os << ' ' << md_cell(s.name) << " |";
-  os << "\n|---|";
-  for (std::size_t i = 0; i < sets.size(); ++i) os << "---|";
-  os << '\n';
-  for (const auto& [label, cell] : rows) {
-    os << "| " << label << " |";
-    for (const auto& s : sets) os << ' ' << cell(s) << " |";
-    os << '\n';
-  }
+  os << sets_table(sets, rows);
   if (any_mixed) os << "\n\\* runs of this set used different values; the first run's are shown.\n";
   return os.str();
 }
@@ -622,18 +633,7 @@ std::string metrics_table(const std::vector<SetSummary>& sets) {
       {"Runs measured", [](const SetSummary& s) {
          return std::to_string(s.metrics_runs) + "/" + std::to_string(s.runs);
        }}};
-  std::ostringstream os;
-  os << "| |";
-  for (const auto& s : sets) os << ' ' << md_cell(s.name) << " |";
-  os << "\n|---|";
-  for (std::size_t i = 0; i < sets.size(); ++i) os << "---|";
-  os << '\n';
-  for (const auto& [label, cell] : rows) {
-    os << "| " << label << " |";
-    for (const auto& s : sets) os << ' ' << cell(s) << " |";
-    os << '\n';
-  }
-  return os.str();
+  return sets_table(sets, rows);
 }
 
 std::string plot_stem(const std::string& set_name) {

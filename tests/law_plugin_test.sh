@@ -9,6 +9,7 @@
 # 3. a library that is no plug-in, or one built against another law API
 #    version, is refused before anything flies: one line, exit 2.
 source "$(dirname "$0")/lib.sh"
+LAUNCH_AGENT_TIMEOUT_S=2
 scenario="$SRC/config/thesis_course.yaml"
 build_dir="$(dirname "$BIN")"
 cmake --install "$build_dir" --prefix "$WORK/prefix" >"$WORK/install.log" 2>&1 || { cat "$WORK/install.log"; fail "cmake --install"; }
@@ -20,23 +21,14 @@ spring="$WORK/my_law/libspring_law.so"
 crash="$WORK/my_law/libcrash_law.so"
 [ -f "$spring" ] && [ -f "$crash" ] || fail "the example built no plug-in"
 
-launch() {
-  local name=$1
-  shift
-  timeout "$(slow 240)" "$BIN/ddswarm-launch" "$scenario" --mode lockstep --domain "$DOMAIN" \
-    --set sim.agent_timeout_s=2 --log-dir "$WORK/$name" "$@" >"$WORK/$name.log" 2>&1
-  local rc=$?
-  cat "$WORK/$name.log"
-  return $rc
-}
 
-launch spring --set agent.law.type=plugin --set agent.law.library="$spring" \
+launch_lockstep spring --set agent.law.type=plugin --set agent.law.library="$spring" \
   --gs 'takeoff --wait; status; task --speed 0.8' || fail "the plug-in swarm's launch failed"
 grep -q "task complete:" "$WORK/spring.log" || fail "the plug-in swarm did not complete the task"
 grep -q "| law plugin libspring_law.so" "$WORK/spring.log" || fail "the status line does not name the plug-in"
 grep -q "flying the plugin libspring_law.so law" "$WORK/spring/agent_0.log" || fail "agent 0 does not say it flies the plug-in"
 
-launch crash --on-death keep \
+launch_lockstep crash --on-death keep \
   --set "agent.overrides=[{ids: 4, law: {type: plugin, library: \"$crash\", params: {crash_after_s: 15}}}]" \
   --gs 'takeoff --wait; task --speed 0.8' || fail "the launch with a crashing plug-in failed"
 grep -q "task complete:" "$WORK/crash.log" || fail "the five sound drones did not complete the task"
@@ -53,17 +45,8 @@ extern "C" int ddswarm_law_api_version() { return 0; }
 extern "C" void* ddswarm_law_factory() { return nullptr; }
 CPP
 c++ -shared -fPIC -o "$WORK/libold_api.so" "$WORK/old_api.cpp" || fail "could not build the old-API library"
-check_refused() {  # LIB EXPECTED: ddswarm-agent refuses the scenario with LIB, exit 2, one line
-  sed "s#^agent:#agent:\n  law: {type: plugin, library: $1}#" "$scenario" >"$WORK/refused.yaml"
-  timeout 30 "$BIN/ddswarm-agent" --id 0 --config "$WORK/refused.yaml" --domain "$DOMAIN" >"$WORK/refused.log" 2>&1
-  local rc=$?
-  cat "$WORK/refused.log"
-  [ $rc -eq 2 ] || fail "ddswarm-agent with $1 exited $rc, not 2"
-  [ "$(wc -l <"$WORK/refused.log")" -eq 1 ] || fail "the refusal is not one line"
-  grep -qF "$2" "$WORK/refused.log" || fail "the refusal does not say: $2"
-}
-check_refused "$WORK/libold_api.so" \
+refused_law "{type: plugin, library: $WORK/libold_api.so}" \
   "refused.yaml:64: agent.law.library = $WORK/libold_api.so: was built against law API version 0, this ddswarm has version 1"
-check_refused /lib/x86_64-linux-gnu/libm.so.6 "is not a ddswarm law plug-in"
-check_refused "$WORK/missing.so" "agent.law.library = $WORK/missing.so: no such file"
+refused_law "{type: plugin, library: /lib/x86_64-linux-gnu/libm.so.6}" "is not a ddswarm law plug-in"
+refused_law "{type: plugin, library: $WORK/missing.so}" "agent.law.library = $WORK/missing.so: no such file"
 echo PASS

@@ -140,3 +140,29 @@ shm_ports() {
     grep -o '/dev/shm/fastrtps_port[0-9]*\( (deleted)\)\?' /proc/"$pid"/maps 2>/dev/null | sort -u
   done
 }
+
+# launch_lockstep NAME ARGS...: ddswarm-launch of $scenario in lockstep on the
+# test's domain, logs in $WORK/NAME/, its output in $WORK/NAME.log (printed);
+# returns the launcher's exit code. Set LAUNCH_AGENT_TIMEOUT_S (default 5).
+launch_lockstep() {
+  local name=$1
+  shift
+  timeout "$(slow 300)" "$BIN/ddswarm-launch" "$scenario" --mode lockstep --domain "$DOMAIN" \
+    --set sim.agent_timeout_s="${LAUNCH_AGENT_TIMEOUT_S:-5}" --log-dir "$WORK/$name" "$@" >"$WORK/$name.log" 2>&1
+  local rc=$?
+  cat "$WORK/$name.log"
+  return $rc
+}
+
+# refused_law LAW EXPECTED: ddswarm-agent refuses $scenario with agent.law LAW
+# (inserted at the agent section's first line, line 64 of thesis_course.yaml)
+# before anything flies: exit 2 and one line that contains EXPECTED.
+refused_law() {
+  sed "s#^agent:#agent:\n  law: $1#" "$scenario" >"$WORK/refused.yaml"
+  timeout 60 "$BIN/ddswarm-agent" --id 0 --config "$WORK/refused.yaml" --domain "$DOMAIN" >"$WORK/refused.log" 2>&1
+  local rc=$?
+  cat "$WORK/refused.log"
+  [ $rc -eq 2 ] || fail "ddswarm-agent with law $1 exited $rc, not 2"
+  [ "$(wc -l <"$WORK/refused.log")" -eq 1 ] || fail "the refusal is not one line"
+  grep -qF "$2" "$WORK/refused.log" || fail "the refusal does not say: $2"
+}

@@ -9,22 +9,13 @@
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/config/thesis_course.yaml"
 examples="$SRC/examples/python_law"
-launch() {
-  local name=$1
-  shift
-  timeout "$(slow 300)" "$BIN/ddswarm-launch" "$scenario" --mode lockstep --domain "$DOMAIN" \
-    --set sim.agent_timeout_s=5 --log-dir "$WORK/$name" "$@" >"$WORK/$name.log" 2>&1
-  local rc=$?
-  cat "$WORK/$name.log"
-  return $rc
-}
 
-launch boids --set agent.law.type=python --set agent.law.module="$examples/boids.py" \
+launch_lockstep boids --set agent.law.type=python --set agent.law.module="$examples/boids.py" \
   --set agent.law.class=Boids --gs 'takeoff --wait; status; task --speed 0.8' || fail "the Python swarm's launch failed"
 grep -q "task complete:" "$WORK/boids.log" || fail "the Python swarm did not complete the task"
 grep -q "| law python Boids" "$WORK/boids.log" || fail "the status line does not name the Python law"
 
-launch broken \
+launch_lockstep broken \
   --set "agent.overrides=[{ids: 1, law: {type: python, module: \"$examples/broken.py\", class: RaisesLater, params: {after_s: 12}}}]" \
   --gs 'takeoff --wait; task --speed 0.8; status' || fail "the launch with a failing Python law failed"
 grep -q "task complete:" "$WORK/broken.log" || fail "the five sound drones did not complete the task"
@@ -35,19 +26,10 @@ grep -q "ddswarm python law: RaisesLater.step: ZeroDivisionError: division by ze
   fail "agent 1's log lacks the exception"
 grep -q 'broken.py([0-9]*): divide' "$WORK/broken/agent_1.log" || fail "agent 1's log lacks the traceback"
 
-refused() {  # LAW EXPECTED: ddswarm-agent refuses agent.law LAW with EXPECTED, one line, exit 2
-  sed "s#^agent:#agent:\n  law: $1#" "$scenario" >"$WORK/refused.yaml"
-  timeout 60 "$BIN/ddswarm-agent" --id 0 --config "$WORK/refused.yaml" --domain "$DOMAIN" >"$WORK/refused.log" 2>&1
-  local rc=$?
-  cat "$WORK/refused.log"
-  [ $rc -eq 2 ] || fail "ddswarm-agent with law $1 exited $rc, not 2"
-  [ "$(wc -l <"$WORK/refused.log")" -eq 1 ] || fail "the refusal is not one line"
-  grep -qF "$2" "$WORK/refused.log" || fail "the refusal does not say: $2"
-}
-refused "{type: python, module: $WORK/nope.py, class: X}" "refused.yaml:64: agent.law.module = $WORK/nope.py: no such file"
-refused "{type: python, module: $examples/boids.py, class: Nope}" "agent.law.class = Nope: no such class in $examples/boids.py"
-refused "{type: python, module: $examples/boids.py, class: Boids, params: {cohesion_gian: 1}}" \
+refused_law "{type: python, module: $WORK/nope.py, class: X}" "refused.yaml:64: agent.law.module = $WORK/nope.py: no such file"
+refused_law "{type: python, module: $examples/boids.py, class: Nope}" "agent.law.class = Nope: no such class in $examples/boids.py"
+refused_law "{type: python, module: $examples/boids.py, class: Boids, params: {cohesion_gian: 1}}" \
   "refused.yaml:64: agent.law.params.cohesion_gian = 1: unknown parameter (this law takes"
-refused "{type: python, module: $examples/boids.py, class: Boids, params: {radius_m: -1}}" \
+refused_law "{type: python, module: $examples/boids.py, class: Boids, params: {radius_m: -1}}" \
   "agent.law.class = Boids: Python ValueError: radius_m must be > 0, not -1.0"
 echo PASS

@@ -7,17 +7,8 @@
 #    says why; the five others complete the task.
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/config/thesis_course.yaml"
-launch() {
-  local name=$1
-  shift
-  timeout "$(slow 240)" "$BIN/ddswarm-launch" "$scenario" --mode lockstep --domain "$DOMAIN" \
-    --set sim.agent_timeout_s=5 --log-dir "$WORK/$name" "$@" >"$WORK/$name.log" 2>&1
-  local rc=$?
-  cat "$WORK/$name.log"
-  return $rc
-}
 
-launch mixed --set 'agent.overrides=[{ids: "3-5", law: {type: reynolds}}]' \
+launch_lockstep mixed --set 'agent.overrides=[{ids: "3-5", law: {type: reynolds}}]' \
   --gs 'takeoff --wait; status; task --speed 0.8' || fail "the mixed swarm's launch failed"
 grep -q "law 3 reynolds, 3 thesis\|laws 3 reynolds, 3 thesis" "$WORK/mixed.log" ||
   fail "the status line does not name the swarm's two laws"
@@ -25,7 +16,7 @@ grep -q "task complete:" "$WORK/mixed.log" || fail "the mixed swarm did not comp
 grep -q "flying the reynolds law" "$WORK/mixed/agent_3.log" || fail "agent 3 does not fly Reynolds"
 grep -q "flying the" "$WORK/mixed/agent_0.log" && fail "agent 0 flies another law than the thesis's"
 
-launch fault --set 'agent.overrides=[{ids: 2, law: {type: thesis, fault: throw, fault_after_s: 12}}]' \
+launch_lockstep fault --set 'agent.overrides=[{ids: 2, law: {type: thesis, fault: throw, fault_after_s: 12}}]' \
   --gs 'takeoff --wait; task --speed 0.8; status; status --drones' || fail "the faulted swarm's launch failed"
 grep -q "task complete:" "$WORK/fault.log" || fail "the five sound drones did not complete the task"
 grep -q "lost drones (agent lost, failsafe): 2" "$WORK/fault.log" || fail "drone 2 is not reported lost"
