@@ -89,6 +89,10 @@ struct LawConfig {
   double fault_after_s = 0;
 
   void validate() const;  ///< builds the law once: throws FieldError("agent.law.params.…")
+  /// The thesis's law with nothing wrapped around it (no injected fault, obstacles as it chooses).
+  bool plain_thesis() const {
+    return type == LawType::kThesis && fault == Fault::kNone && obstacles == Obstacles::kAuto;
+  }
   /// "thesis", "reynolds", ... or "plugin libmylaw.so" (the library's file name).
   std::string name() const;
 };
