@@ -15,12 +15,7 @@
 #include <set>
 #include <utility>
 
-#include "agent/comm_model.hpp"
-#include "agent/law_frame.hpp"
-#include "agent/law_registry.hpp"
-#include "agent/mission_fsm.hpp"
-#include "agent/peer_source.hpp"
-#include "agent/swarm_law.hpp"
+#include "agent/drone_brain.hpp"
 #include "common/config_error.hpp"
 #include "common/convert.hpp"
 #include "common/participant.hpp"
@@ -108,69 +103,58 @@ bool finite(const msg::Vec3& v) {
 
 }  // namespace
 
-/// One drone's brain: its mission, its peer knowledge, its answers. In an
-/// agent host many of these share a process and its one SwarmState sample,
-/// but each sees only what its drone would receive and keeps its own state.
-struct DroneBrain {
-  const int id;
-  const std::uint64_t instance = random_instance();
-  std::unique_ptr<MissionFsm> fsm;
-  TruthPeerSource truth{id};
-  std::unique_ptr<ModelledPeerSource> modelled;  // when comm asks for more than exact truth
-  PeerSource* peers = &truth;
-  std::uint64_t fed_tick = ~0ULL;  // the tick whose truth and beacons the peer source has taken
-  // (issuer, seq) -> the apply_tick it came with; oldest first for pruning.
-  std::map<std::pair<std::uint64_t, std::uint32_t>, std::uint64_t> seen_missions;
-  std::deque<std::pair<std::uint64_t, std::uint32_t>> seen_order;
-  std::uint32_t last_mission_seq = 0;      // the last mission command accepted: its seq
-  std::uint64_t last_mission_issuer = 0;   // and its issuer_instance
-  bool caught_up = false;  // the mission in force (the ring) was taken from the first sample
-  std::uint64_t rejected = 0, sent = 0;
+/// One drone this process flies: its brain (the pure part) and what only
+/// the DDS edge knows of it.
+struct Drone {
+  DroneBrain brain;
   std::uint64_t rival = 0;  // another instance heard on this id during the start-up probe
   std::string rival_where;
-  std::vector<Eigen::Vector3d> ranged;
-  std::vector<float> ranges, angles;
-  std::vector<std::uint8_t> hits;
-  // The swarm law this drone flies (agent.law, or its override), built with
-  // the mission; what it is shown each tick; and its faults.
-  const LawConfig* law_cfg = nullptr;
-  std::unique_ptr<law::SwarmLaw> law;
-  std::vector<law::Peer> law_peers;
-  std::vector<law::Ray> law_rays;
-  double yaw_rate_rad_s = 0;      // the law's, this tick
-  std::string law_fault;          // the first fault; empty while the law is sound
-  std::uint64_t law_faults = 0;   // ticks the law failed (one, since it is not asked again)
-  double law_fault_at_s = -1;     // sim time of the fault
-  bool fault_landing = false;     // the fault's hover ended and the landing was ordered
-  // The last answer sent. A tick that comes again (lockstep: the server
-  // published it twice, a sample was lost) gets the same answer again, not
-  // a second run of the mission machine and the law.
-  std::optional<msg::VelocityCommand> last_answer;
   // Wall time of the first swarm state, since this brain began answering,
   // whose row for this drone says the server hears no live agent for it
   // (no DRONE_AGENT_LIVE); -1 while the server hears it.
   double unheard_since = -1;
 
-  explicit DroneBrain(int drone_id) : id(drone_id) {}
-
-  /// Remembers m as the last command accepted; every VelocityCommand reports it.
-  void accepted(const msg::MissionCommand& m) {
-    last_mission_seq = m.seq();
-    last_mission_issuer = m.issuer_instance();
-  }
-
-  void reset_mission() {
-    fsm.reset();
-    law.reset();
-    modelled.reset();
-    peers = &truth;
-    seen_missions.clear();
-    seen_order.clear();
-    fed_tick = ~0ULL;
-    caught_up = false;
-    last_answer.reset();
-  }
+  Drone(int id, const AgentAppConfig& c)
+      : brain(id, random_instance(), c.agent, c.comm, c.scenario.drones) {}
 };
+
+namespace {
+
+/// The command as the wire carries it.
+msg::VelocityCommand command_msg(const DroneCommand& c) {
+  msg::VelocityCommand m;
+  m.drone_id(static_cast<std::uint16_t>(c.drone_id));
+  m.tick(c.tick);
+  m.sim_time_s(c.sim_time_s);
+  m.velocity(to_msg(c.velocity));
+  m.yaw_rate_rad_s(c.yaw_rate_rad_s);
+  m.motors_on(c.motors_on);
+  m.phase(static_cast<std::uint8_t>(c.phase));
+  m.busy(c.busy);
+  m.mission_seq(c.mission_seq);
+  m.mission_issuer(c.mission_issuer);
+  m.agent_instance(c.agent_instance);
+  if (c.beacon) {
+    msg::Beacon& b = m.own_beacon();
+    b.drone_id(static_cast<std::uint16_t>(c.drone_id));
+    b.tick(c.tick);
+    b.stamp_s(c.beacon->stamp_s);
+    b.position(to_msg(c.beacon->reported_p));
+    b.velocity(to_msg(c.beacon_velocity));
+    m.has_beacon(true);
+  }
+  return m;
+}
+
+void log_note(const BrainNote& n) {
+  switch (n.level) {
+    case BrainNote::Level::kInfo: spdlog::info("{}", n.text); break;
+    case BrainNote::Level::kWarn: spdlog::warn("{}", n.text); break;
+    case BrainNote::Level::kError: spdlog::error("{}", n.text); break;
+  }
+}
+
+}  // namespace
 
 struct AgentApp::Impl {
   AgentAppConfig cfg;
@@ -182,8 +166,8 @@ struct AgentApp::Impl {
   Writer<msg::Beacon> w_beacon;
 
   std::mutex mu;  // guards everything below (DDS callbacks run on Fast DDS threads)
-  std::vector<std::unique_ptr<DroneBrain>> brains;
-  std::map<int, DroneBrain*> by_id;
+  std::vector<std::unique_ptr<Drone>> brains;
+  std::map<int, Drone*> by_id;
   std::optional<SceneConfig> scene;
   eprosima::fastrtps::rtps::GuidPrefix_t server;  // the scene's publisher
   std::uint64_t server_instance = 0;              // its Scene.server_instance
@@ -206,9 +190,8 @@ struct AgentApp::Impl {
   bool loss_logged = false;    // agent.state_loss said so in the log
   bool copy_logged = false;    // a copied scene was refused, and the log said so
   bool bad_scene_logged = false;  // a scene that cannot be flown was refused, and the log said so
-  // This tick's swarm members (live agent, not in failsafe, finite position),
-  // by id: converted once per sample for every brain in the process.
-  std::vector<PeerObservation> roster;
+  // This tick's sample, converted once for every brain in the process.
+  SwarmTick swarm;
   // How the swarm state should be read: best-effort with
   // dds.best_effort_streams, in both time modes (a lockstep server publishes
   // a tick again when answers stay missing), else reliably. The run loop
@@ -289,7 +272,7 @@ struct AgentApp::Impl {
         w_beacon(dds.writer<msg::Beacon>()),
         loss_rng(0x5eed1055ULL + static_cast<std::uint64_t>(cfg.drone_ids.at(0))) {
     for (int id : cfg.drone_ids) {
-      brains.push_back(std::make_unique<DroneBrain>(id));
+      brains.push_back(std::make_unique<Drone>(id, cfg));
       by_id[id] = brains.back().get();
     }
     Reader<msg::AgentStatus>* probe = nullptr;
@@ -299,7 +282,7 @@ struct AgentApp::Impl {
           &dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& s, const fdds::SampleInfo&) {
             std::lock_guard<std::mutex> lock(mu);
             auto it = by_id.find(s.drone_id());
-            if (it == by_id.end() || s.agent_instance() == it->second->instance) return;
+            if (it == by_id.end() || s.agent_instance() == it->second->brain.instance()) return;
             it->second->rival = s.agent_instance();
             it->second->rival_where = s.host().to_string() + " pid " + std::to_string(s.pid());
           });
@@ -313,7 +296,7 @@ struct AgentApp::Impl {
       std::lock_guard<std::mutex> lock(mu);
       for (const auto& b : brains)
         if (b->rival)
-          throw DuplicateAgent("drone " + std::to_string(b->id) + " is already flown by agent " +
+          throw DuplicateAgent("drone " + std::to_string(b->brain.id()) + " is already flown by agent " +
                                fmt::format("{:016x}", b->rival) + " (" + b->rival_where + ")");
     }
     // Every agent hearing every other's heartbeat is O(N^2) traffic: at 64
@@ -394,9 +377,9 @@ struct AgentApp::Impl {
       // so the old mission no longer applies. Start over and catch up with
       // whatever the new server's ring says.
       for (const auto& b : brains) {
-        spdlog::warn("drone {}: new server instance {:016x} (was {:016x}): mission reset", b->id,
-                     s.server_instance(), server_instance);
-        b->reset_mission();
+        spdlog::warn("drone {}: new server instance {:016x} (was {:016x}): mission reset",
+                     b->brain.id(), s.server_instance(), server_instance);
+        b->brain.reset();
       }
       have_tick = false;
     }
@@ -427,138 +410,20 @@ struct AgentApp::Impl {
                    label, reach, s.sensor_max_range_m());
   }
 
-  void start_brain(DroneBrain& b) {
-    b.fsm = std::make_unique<MissionFsm>(b.id, cfg.agent, *scene);
-    b.law_cfg = &cfg.agent.law_for(b.id);
-    law::LawContext ctx;
-    ctx.drone_id = b.id;
-    ctx.num_drones = cfg.scenario.drones;
-    ctx.inter_distance_m = cfg.agent.inter_distance_m;
-    ctx.max_speed_mps = cfg.agent.max_speed_mps;
-    ctx.control_period_s = 1.0 / scene_control_rate_hz;
-    try {
-      b.law = make_law(*b.law_cfg, ctx, law::Rng(law_seed(scene_seed, b.id)), cfg.agent);
-    } catch (const std::exception& e) {
-      // Checked when the config was read; a law can still fail on what only
-      // the scene says (its control rate).
-      on_law_fault(b, std::string("could not be built: ") + e.what(), 0.0);
-    }
-    if (b.law_cfg->type != LawType::kThesis && &b == brains.front().get())
-      spdlog::info("{}: flying the {} law", label, b.law_cfg->name());
+  void start_brain(Drone& d) {
+    for (const auto& n : d.brain.start(*scene, scene_control_rate_hz, scene_seed)) log_note(n);
+    if (&d != brains.front().get()) return;
+    if (d.brain.law_config().type != LawType::kThesis)
+      spdlog::info("{}: flying the {} law", label, d.brain.law_config().name());
     if (cfg.comm.ideal()) return;
-    const double tick_s = 1.0 / scene_control_rate_hz;
     const double ticks_per_beacon = scene_control_rate_hz / cfg.comm.beacon_rate_hz;
     if (cfg.comm.source == PeerSourceType::kBeacons &&
-        std::abs(ticks_per_beacon - std::round(ticks_per_beacon)) > 1e-9 && &b == brains.front().get())
+        std::abs(ticks_per_beacon - std::round(ticks_per_beacon)) > 1e-9)
       spdlog::warn("{}: comm.beacon_rate_hz {} does not divide the control rate {} Hz; "
                    "beacons go every {} ticks",
                    label, cfg.comm.beacon_rate_hz, scene_control_rate_hz, std::round(ticks_per_beacon));
-    b.modelled = std::make_unique<ModelledPeerSource>(cfg.comm, scene_seed, b.id, tick_s);
-    b.peers = b.modelled.get();
-    if (&b == brains.front().get())
-      spdlog::info("{}: peers from {} through the communication model", label,
-                   cfg.comm.source == PeerSourceType::kBeacons ? "beacons" : "truth");
-  }
-
-  /// Hover this long (s, sim) after a law faults, then land.
-  static constexpr double kLawFaultHoverS = 2.0;
-
-  void on_law_fault(DroneBrain& b, const std::string& why, double t) {
-    ++b.law_faults;
-    if (!b.law_fault.empty()) return;
-    b.law_fault = one_line(why);
-    b.law_fault_at_s = t;
-    spdlog::error("drone {}: the {} law faulted at sim time {:.2f} s: {}; the drone hovers {:.0f} s, "
-                  "then lands, and takes no mission command",
-                  b.id, b.law_cfg ? b.law_cfg->name() : "thesis", t, b.law_fault,
-                  kLawFaultHoverS);
-  }
-
-  /// A faulted law's drone: hovers where it is, then lands through its
-  /// mission machine; the law is not asked again.
-  void fly_fault(DroneBrain& b, LawInput& in, MissionOutput& out, const Observation& obs) {
-    in.swarm_enabled = false;
-    if (out.phase == Phase::kIdle || out.phase == Phase::kLanding) return;
-    if (obs.sim_time_s - b.law_fault_at_s < kLawFaultHoverS) {
-      in.mission_velocity.setZero();
-      out.busy = true;
-      return;
-    }
-    if (!b.fault_landing) {
-      b.fault_landing = true;
-      MissionCommand land;
-      land.type = MissionType::kLand;
-      land.target = b.id;
-      land.seq = 1;
-      land.issuer = "law-fault";
-      b.fsm->apply(land, obs);
-      out = b.fsm->step(obs);
-      set_mission(in, out);
-      in.swarm_enabled = false;
-    }
-  }
-
-  /// What drone b's law is shown: its own state as it knows it, the peers
-  /// its source delivers (in.peers_world, in the source's order), the scan.
-  law::Observation observe(DroneBrain& b, const LawInput& in, const MissionOutput& out,
-                           const Observation& obs, const msg::SwarmState& s) {
-    law::Observation o;
-    o.drone_id = b.id;
-    o.tick = s.tick();
-    o.sim_time_s = s.sim_time_s();
-    o.dt_s = control_period_s;
-    o.p_world = in.p_world;
-    o.v_world = obs.v_world;
-    o.q_world_body = in.q_world_body;
-    b.law_peers.clear();
-    auto add = [&](std::size_t k, const PeerObservation& h) {
-      const Eigen::Vector3d p = k < in.peers_world.size() ? in.peers_world[k] : h.p_world;
-      b.law_peers.push_back({h.id, p, h.v_world, s.sim_time_s() - h.stamp_s});
-    };
-    if (b.modelled) {
-      const auto heard = b.modelled->heard(s.sim_time_s());
-      for (std::size_t k = 0; k < heard.size(); ++k) add(k, heard[k]);
-    } else {
-      std::size_t k = 0;
-      for (const auto& r : roster)
-        if (r.id != b.id) add(k++, r);
-    }
-    b.law_rays.clear();
-    for (std::size_t k = 0; k < in.ray_range_m.size(); ++k)
-      b.law_rays.push_back({in.ray_range_m[k], in.ray_hit[k] != 0, in.ray_yaw_body_rad[k], 0.0});
-    o.peers = b.law_peers;
-    o.rays = b.law_rays;
-    o.phase = static_cast<law::Phase>(out.phase);
-    o.mission_velocity = in.mission_velocity;
-    if (out.phase == Phase::kTask || out.phase == Phase::kSwarm)
-      o.goal_world = Eigen::Vector3d(scene->goal_xy.x(), scene->goal_xy.y(), out.altitude_target_m);
-    o.inter_distance_m = in.inter_distance_m;
-    o.altitude_target_m = in.altitude_target_m;
-    o.max_speed_mps = cfg.agent.max_speed_mps;
-    return o;
-  }
-
-  /// This tick's command: the drone's law inside the framework (step_law).
-  /// A law that throws or answers a non-finite number faults here, and its
-  /// drone starts to hover this very tick.
-  LawTerms command(DroneBrain& b, LawInput& in, MissionOutput& out, const Observation& obs,
-                   const msg::SwarmState& s) {
-    // The thesis's own law, as configured by default: evaluate_law from the
-    // peer positions the agent already holds. Through the interface it gives
-    // the same command bit for bit (agent_law_frame_test), but building its
-    // Observation copies every peer twice a tick: 260,000 copies a tick in a
-    // 512-drone agent host.
-    if (b.law_cfg && b.law_cfg->plain_thesis()) return evaluate_law(in, cfg.agent);
-    law::SwarmLaw* l = b.law_fault.empty() ? b.law.get() : nullptr;
-    LawStep r = l && in.swarm_enabled ? step_law(l, observe(b, in, out, obs, s), in, cfg.agent)
-                                      : step_law(nullptr, {}, in, cfg.agent);
-    if (!r.fault.empty()) {
-      on_law_fault(b, r.fault, obs.sim_time_s);
-      fly_fault(b, in, out, obs);
-      r = step_law(nullptr, {}, in, cfg.agent);
-    }
-    b.yaw_rate_rad_s = r.yaw_rate_rad_s;
-    return r.terms;
+    spdlog::info("{}: peers from {} through the communication model", label,
+                 cfg.comm.source == PeerSourceType::kBeacons ? "beacons" : "truth");
   }
 
   void publish_status() {
@@ -567,22 +432,22 @@ struct AgentApp::Impl {
       std::lock_guard<std::mutex> lock(mu);
       char host[64] = {};
       gethostname(host, sizeof host - 1);
-      for (const auto& b : brains) {
+      for (const auto& d : brains) {
+        const DroneBrain& b = d->brain;
         msg::AgentStatus s;
-        s.drone_id(static_cast<std::uint16_t>(b->id));
-        s.agent_instance(b->instance);
+        s.drone_id(static_cast<std::uint16_t>(b.id()));
+        s.agent_instance(b.instance());
         s.host(host);
         s.pid(getpid());
-        const Phase phase = !b->law_fault.empty() ? Phase::kFailsafe : b->fsm ? b->fsm->phase() : Phase::kIdle;
-        s.phase(static_cast<std::uint8_t>(phase));
+        s.phase(static_cast<std::uint8_t>(b.phase()));
         s.server_lost(server_lost);
         s.last_tick(last_tick);
-        s.inter_distance_m(b->fsm ? b->fsm->inter_distance_m() : cfg.agent.inter_distance_m);
-        s.rejected_samples(static_cast<std::uint32_t>(rejected + b->rejected + malformed_samples().load()));
-        s.commands_sent(static_cast<std::uint32_t>(b->sent));
-        s.law(cfg.agent.law_for(b->id).name().substr(0, 32));
-        s.law_faults(static_cast<std::uint32_t>(b->law_faults));
-        s.law_fault(b->law_fault.substr(0, 255));
+        s.inter_distance_m(b.inter_distance_m());
+        s.rejected_samples(static_cast<std::uint32_t>(rejected + b.rejected() + malformed_samples().load()));
+        s.commands_sent(static_cast<std::uint32_t>(b.sent()));
+        s.law(b.law_config().name().substr(0, 32));
+        s.law_faults(static_cast<std::uint32_t>(b.law_faults()));
+        s.law_fault(b.law_fault().substr(0, 255));
         out.push_back(std::move(s));
       }
     }
@@ -628,187 +493,79 @@ struct AgentApp::Impl {
     }
     have_tick = true;
     last_tick = s.tick();
-    roster.clear();
-    for (const auto& d : s.drones()) {
+    convert(s);
+    for (const auto& d : brains) answer(*d);
+  }
+
+  /// The sample as every brain reads it (swarm), converted once.
+  void convert(const msg::SwarmState& s) {
+    swarm.tick = s.tick();
+    swarm.sim_time_s = s.sim_time_s();
+    swarm.drones.resize(s.drones().size());
+    swarm.roster.clear();
+    for (std::size_t k = 0; k < s.drones().size(); ++k) {
+      const auto& d = s.drones()[k];
+      DroneRow& r = swarm.drones[k];
+      r.id = d.drone_id();
+      r.valid = finite(d.position()) && finite(d.velocity());
+      r.agent_live = (d.flags() & msg::DRONE_AGENT_LIVE) != 0;
+      r.p_world = from_msg(d.position());
+      r.v_world = from_msg(d.velocity());
+      r.q_world_body = from_msg(d.orientation());
+      r.ray_range_m = {};
+      r.ray_hit = {};
+      r.ray_yaw_body_rad = {};
+      if (k < s.scans().size()) {
+        const auto& sc = s.scans()[k];
+        r.ray_range_m = sc.range_m();
+        r.ray_hit = sc.hit();
+        r.ray_yaw_body_rad = sc.angle_body_rad();
+      }
       // A drone without a live agent (lost: the server's failsafe flies it,
       // hovering then landing) is no member of the swarm: no attraction to
       // it, or the swarm would stay tied to a wreck. The distance sensors
       // still see it as an obstacle.
-      if (!(d.flags() & msg::DRONE_AGENT_LIVE) || (d.flags() & msg::DRONE_FAILSAFE)) continue;
+      if (!r.agent_live || (d.flags() & msg::DRONE_FAILSAFE)) continue;
       if (!finite(d.position())) {
         ++rejected;
         continue;
       }
-      PeerObservation o{d.drone_id(), from_msg(d.position()), d.sim_time_s()};
-      if (finite(d.velocity())) o.v_world = from_msg(d.velocity());
-      roster.push_back(o);
+      PeerObservation o{d.drone_id(), r.p_world, d.sim_time_s()};
+      if (finite(d.velocity())) o.v_world = r.v_world;
+      swarm.roster.push_back(o);
     }
-    for (const auto& b : brains) answer(*b, s);
+    swarm.missions.resize(s.recent_commands().size());
+    for (std::size_t k = 0; k < s.recent_commands().size(); ++k) {
+      const auto& m = s.recent_commands()[k];
+      RelayedMission& r = swarm.missions[k];
+      r.command = from_msg(m);
+      r.issuer_instance = m.issuer_instance();
+      r.apply_tick = m.apply_tick();
+      r.problem = mission_problem(m);
+    }
+    swarm.beacons.clear();
+    for (const auto& bc : s.beacons())
+      swarm.beacons.push_back({bc.drone_id(), bc.tick(), bc.stamp_s(), from_msg(bc.position()),
+                               from_msg(bc.true_position())});
   }
 
-  void answer(DroneBrain& b, const msg::SwarmState& s) {
-    const int id = b.id;
-    if (!b.fsm) return;
-    if (s.drones().size() <= static_cast<std::size_t>(id) || s.drones()[id].drone_id() != id) {
-      ++b.rejected;
-      return;
-    }
-    const auto& me = s.drones()[id];
-    if (!finite(me.position()) || !finite(me.velocity())) {
-      ++b.rejected;
-      return;
-    }
+  /// Drone d's brain answers the tick; this writes and logs what it says.
+  void answer(Drone& d) {
     // Answering, yet marked agent-less: the server does not hear this agent.
-    if (b.sent > 0 && !(me.flags() & msg::DRONE_AGENT_LIVE)) {
-      if (b.unheard_since < 0) b.unheard_since = wall_seconds();
-    } else {
-      b.unheard_since = -1;
-    }
-    if (b.last_answer && b.last_answer->tick() == s.tick()) {
-      w_cmd.write(*b.last_answer);
-      return;
-    }
-
-    Observation obs;
-    obs.sim_time_s = s.sim_time_s();
-    obs.tick = s.tick();
-    obs.p_world = from_msg(me.position());
-    obs.v_world = from_msg(me.velocity());
-    obs.on_ground = obs.p_world.z() < scene->ground_z_m + 0.15 && obs.v_world.norm() < 0.5;
-
-    // The first sample after joining: commands the swarm applied before this
-    // agent was here are caught up with (a restarted agent rejoins its mission).
-    const bool joining = !b.caught_up;
-    b.caught_up = true;
-    for (const auto& m : s.recent_commands()) {
-      const auto key = std::make_pair(m.issuer_instance(), m.seq());
-      auto it = b.seen_missions.find(key);
-      // Same command at the same apply tick: already handled (the ring repeats every tick).
-      if (it != b.seen_missions.end() && it->second == m.apply_tick()) continue;
-      if (it == b.seen_missions.end()) {
-        b.seen_order.push_back(key);
-        if (b.seen_order.size() > 1024) {
-          b.seen_missions.erase(b.seen_order.front());
-          b.seen_order.pop_front();
-        }
+    if (const DroneRow* me = swarm.row(d.brain.id()); me && me->valid && d.brain.started()) {
+      if (d.brain.sent() > 0 && !me->agent_live) {
+        if (d.unheard_since < 0) d.unheard_since = wall_seconds();
+      } else {
+        d.unheard_since = -1;
       }
-      // A new apply tick for a known command is a repeat: the FSM returns the
-      // ack it gave then and changes nothing, so it is acknowledged again, applied once.
-      b.seen_missions[key] = m.apply_tick();
-      MissionCommand c = from_msg(m);
-      if (!mission_problem(m).empty()) {
-        ++b.rejected;
-        MissionAck a{static_cast<std::uint16_t>(id), m.seq(), false, mission_problem(m), b.fsm->phase(), s.tick()};
-        w_ack.write(to_msg(a, m.issuer_instance()));
-        continue;
-      }
-      if (!b.fsm->addressed_to_me(c)) continue;
-      if (!b.law_fault.empty()) {
-        MissionAck a{static_cast<std::uint16_t>(id), m.seq(), false, "swarm law faulted: " + b.law_fault,
-                     b.fsm->phase(), s.tick()};
-        w_ack.write(to_msg(a, m.issuer_instance()));
-        continue;
-      }
-      if (joining && m.apply_tick() < s.tick()) {
-        MissionAck a = b.fsm->resume(c, static_cast<double>(m.apply_tick()) * control_period_s, obs);
-        if (a.accepted) b.accepted(m);
-        w_ack.write(to_msg(a, m.issuer_instance()));
-        spdlog::info("drone {}: joined mid-mission: caught up with {} seq {} of tick {}{}", id,
-                     to_string(c.type), c.seq, m.apply_tick(), a.accepted ? "" : ": " + a.reason);
-        continue;
-      }
-      MissionAck a = b.fsm->apply(c, obs);
-      if (a.accepted) b.accepted(m);  // relayed by the server (SimStatus.mission_seq, mission_issuer)
-      w_ack.write(to_msg(a, m.issuer_instance()));
-      spdlog::info("drone {}: {} seq {} {} at tick {}{}", id, to_string(c.type), c.seq,
-                   a.accepted ? "accepted" : "rejected", s.tick(), a.accepted ? "" : ": " + a.reason);
     }
-
-    // Each tick's truth and beacons go to the peer source once, even when the
-    // server re-sends the same tick while it waits.
-    const bool new_tick = s.tick() != b.fed_tick;
-    b.fed_tick = s.tick();
-    Eigen::Vector3d own_p = obs.p_world;
-    if (b.modelled) {
-      if (new_tick) {
-        b.modelled->set_tick(s.tick(), s.sim_time_s(), obs.p_world);
-        b.modelled->on_truth(s.sim_time_s(), roster);  // skips its own id
-        for (const auto& bc : s.beacons()) {
-          if (bc.drone_id() == id || bc.drone_id() >= s.drones().size()) continue;
-          PeerMessage pm{bc.drone_id(), bc.tick(), bc.stamp_s(), from_msg(bc.position()), from_msg(bc.true_position())};
-          b.modelled->on_beacon(pm, obs.p_world);
-        }
-      }
-      own_p = b.modelled->channel().noisy_own_position(obs.p_world, s.tick());
-    } else if (new_tick) {
-      b.peers->on_truth(s.sim_time_s(), roster);  // skips its own id
-    }
-
-    MissionOutput out = b.fsm->step(obs);
-    LawInput in;
-    in.p_world = own_p;
-    in.q_world_body = from_msg(me.orientation()).normalized();
-    const auto& peer_pos = b.peers->peers(s.sim_time_s());
-    b.ranged.clear();
-    if (b.modelled && cfg.comm.range_measurements) {
-      // A law that uses distances: direction from the position estimates,
-      // magnitude from the (noisy) UWB range to that peer.
-      for (const auto& h : b.modelled->heard(s.sim_time_s())) {
-        Eigen::Vector3d d = h.p_world - own_p;
-        auto r = b.modelled->range_to(h.id);
-        b.ranged.push_back(r && d.norm() > 1e-6 ? Eigen::Vector3d(own_p + d.normalized() * *r) : h.p_world);
-      }
-      in.peers_world = b.ranged;
-    } else {
-      in.peers_world = peer_pos;
-    }
-    if (s.scans().size() > static_cast<std::size_t>(id)) {
-      const auto& sc = s.scans()[id];
-      std::size_t k = std::min({sc.range_m().size(), sc.hit().size(), sc.angle_body_rad().size()});
-      b.ranges.assign(sc.range_m().begin(), sc.range_m().begin() + k);
-      b.hits.assign(sc.hit().begin(), sc.hit().begin() + k);
-      b.angles.assign(sc.angle_body_rad().begin(), sc.angle_body_rad().begin() + k);
-      for (std::size_t j = 0; j < k; ++j)
-        if (!std::isfinite(b.ranges[j])) {
-          b.hits[j] = 0;
-          ++b.rejected;
-        }
-    }
-    in.ray_range_m = b.ranges;
-    in.ray_hit = b.hits;
-    in.ray_yaw_body_rad = b.angles;
-    set_mission(in, out);
-    if (!b.law_fault.empty()) fly_fault(b, in, out, obs);
-    Eigen::Vector3d v = Eigen::Vector3d::Zero();
-    if (out.motors_on) v = command(b, in, out, obs, s).velocity;
-    if (!b.law_fault.empty()) out.phase = Phase::kFailsafe;
-
-    msg::VelocityCommand cmd;
-    cmd.drone_id(static_cast<std::uint16_t>(id));
-    cmd.tick(s.tick());
-    cmd.sim_time_s(s.sim_time_s());
-    cmd.velocity(to_msg(v));
-    cmd.yaw_rate_rad_s(b.yaw_rate_rad_s);  // the thesis law holds the heading: the sensors keep their layout
-    cmd.motors_on(out.motors_on);
-    cmd.phase(static_cast<std::uint8_t>(out.phase));
-    cmd.busy(out.busy);
-    cmd.mission_seq(b.last_mission_seq);
-    cmd.mission_issuer(b.last_mission_issuer);
-    cmd.agent_instance(b.instance);
-    if (b.modelled && cfg.comm.source == PeerSourceType::kBeacons && b.modelled->beacon_due(s.tick())) {
-      PeerMessage pm = b.modelled->beacon(s.tick(), s.sim_time_s(), obs.p_world);
-      msg::Beacon& m = cmd.own_beacon();
-      m.drone_id(static_cast<std::uint16_t>(id));
-      m.tick(s.tick());
-      m.stamp_s(pm.stamp_s);
-      m.position(to_msg(pm.reported_p));
-      m.velocity(me.velocity());
-      cmd.has_beacon(true);
-      if (new_tick) w_beacon.write(m);
-    }
+    TickAnswer a = d.brain.tick(swarm);
+    for (const auto& n : a.notes) log_note(n);
+    for (const auto& k : a.acks) w_ack.write(to_msg(k.ack, k.issuer_instance));
+    if (a.kind == TickAnswer::Kind::kNone) return;
+    const msg::VelocityCommand cmd = command_msg(a.command);
+    if (a.publish_beacon) w_beacon.write(cmd.own_beacon());
     w_cmd.write(cmd);
-    b.last_answer = cmd;
-    ++b.sent;
   }
 
   AgentApp::End run(double duration_s) {
@@ -816,7 +573,7 @@ struct AgentApp::Impl {
     // Both waits spread by process, up to AgentConfig::kRejoinSpread longer,
     // so that agents that missed the server do not all join again at once.
     const double spread =
-        1.0 + AgentConfig::kRejoinSpread * static_cast<double>(brains[0]->instance % 1024) / 1024.0;
+        1.0 + AgentConfig::kRejoinSpread * static_cast<double>(brains[0]->brain.instance() % 1024) / 1024.0;
     JoinPatience join_patience;
     join_patience.lease_s = cfg.dds.lease_duration_s;
     join_patience.scene_wait_s = cfg.agent.rejoin_after_s * spread;
@@ -824,9 +581,11 @@ struct AgentApp::Impl {
     join_patience.handshake_wait_s = cfg.agent.handshake_timeout_s * spread;
     double end = duration_s > 0 ? joined + duration_s : 1e300;
     if (brains.size() == 1)
-      spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->id, brains[0]->instance, getpid());
+      spdlog::info("drone {}: agent {:016x} flying (pid {})", brains[0]->brain.id(),
+                   brains[0]->brain.instance(), getpid());
     else
-      spdlog::info("{}: flying drones {}..{} (pid {})", label, brains.front()->id, brains.back()->id, getpid());
+      spdlog::info("{}: flying drones {}..{} (pid {})", label, brains.front()->brain.id(),
+                   brains.back()->brain.id(), getpid());
     LeaseWatch lease(cfg.dds.lease_duration_s, wall_seconds());
     const StopWaker stop_waker([this] {
       { const std::lock_guard<std::mutex> lock(mu); }  // the loop is waiting, or has not yet tested
@@ -869,7 +628,7 @@ struct AgentApp::Impl {
         view.scene_writer_matched = scenes->matched() > 0;
         view.scene_matched_since_s = scenes->matched_since();
         for (const auto& b : brains)  // < 0: heard, or the server went silent since
-          if (b->unheard_since >= 0) view.unheard_since.emplace_back(b->id, b->unheard_since);
+          if (b->unheard_since >= 0) view.unheard_since.emplace_back(b->brain.id(), b->unheard_since);
         for (const auto& p : dds.peers_named(kServerParticipantName))
           view.servers.push_back({p.prefix == server, p.announced_s, p.authenticated_after_s});
         view.secure = dds.secure();
