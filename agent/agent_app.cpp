@@ -68,21 +68,6 @@ AgentAppConfig load_agent_config(const std::string& path) {
 
 namespace {
 
-SceneConfig scene_from_msg(const msg::Scene& s) {
-  SceneConfig c;
-  c.ground_z_m = s.ground_z_m();
-  for (const auto& cy : s.cylinders())
-    c.cylinders.push_back({Eigen::Vector2d(cy.x(), cy.y()), cy.radius_m(), cy.height_m()});
-  for (const auto& b : s.boxes()) c.boxes.push_back({from_msg(b.center()), from_msg(b.size()), b.yaw_rad()});
-  c.bounds_min = from_msg(s.bounds_min());
-  c.bounds_max = from_msg(s.bounds_max());
-  c.finish_a = from_msg(s.finish_a()).head<2>();
-  c.finish_b = from_msg(s.finish_b()).head<2>();
-  c.goal_xy = from_msg(s.goal()).head<2>();
-  c.start.center_xy = from_msg(s.start_center()).head<2>();
-  return c;
-}
-
 /// Why a scene cannot be flown (empty when it can): the checks the scene
 /// file gets (SceneConfig::validate), and the control rates a server flies.
 /// A broken or hostile Scene sample is refused before anything of it is applied.
@@ -90,7 +75,7 @@ std::string scene_problem(const msg::Scene& s) {
   try {
     check_range("scene.control_rate_hz", s.control_rate_hz(), kMinControlRateHz,
                 kMaxControlRateHz);
-    scene_from_msg(s).validate();
+    from_msg(s).validate();
   } catch (const std::exception& e) {
     return e.what();
   }
@@ -389,7 +374,7 @@ struct AgentApp::Impl {
     control_period_s = 1.0 / s.control_rate_hz();
     scene_control_rate_hz = s.control_rate_hz();
     scene_seed = s.seed();
-    scene = scene_from_msg(s);
+    scene = from_msg(s);
     for (const auto& b : brains) start_brain(*b);
     // Under DDS Security, how long the server took (docs/security.md).
     std::optional<RemotePeer> sender;

@@ -64,4 +64,50 @@ msg::MissionAck to_msg(const MissionAck& a, std::uint64_t issuer_instance) {
   return m;
 }
 
+namespace {
+msg::Vec3 xy(const Eigen::Vector2d& p) { return to_msg(Eigen::Vector3d(p.x(), p.y(), 0)); }
+}  // namespace
+
+SceneConfig from_msg(const msg::Scene& s) {
+  SceneConfig c;
+  c.ground_z_m = s.ground_z_m();
+  for (const auto& cy : s.cylinders())
+    c.cylinders.push_back({Eigen::Vector2d(cy.x(), cy.y()), cy.radius_m(), cy.height_m()});
+  for (const auto& b : s.boxes()) c.boxes.push_back({from_msg(b.center()), from_msg(b.size()), b.yaw_rad()});
+  c.bounds_min = from_msg(s.bounds_min());
+  c.bounds_max = from_msg(s.bounds_max());
+  c.finish_a = from_msg(s.finish_a()).head<2>();
+  c.finish_b = from_msg(s.finish_b()).head<2>();
+  c.goal_xy = from_msg(s.goal()).head<2>();
+  c.start.center_xy = from_msg(s.start_center()).head<2>();
+  return c;
+}
+
+msg::Scene to_msg(const SceneConfig& c) {
+  msg::Scene s;
+  s.ground_z_m(c.ground_z_m);
+  for (const auto& cy : c.cylinders) {
+    msg::Cylinder m;
+    m.x(cy.center_xy.x());
+    m.y(cy.center_xy.y());
+    m.radius_m(cy.radius_m);
+    m.height_m(cy.height_m);
+    s.cylinders().push_back(m);
+  }
+  for (const auto& b : c.boxes) {
+    msg::Box m;
+    m.center(to_msg(b.center));
+    m.size(to_msg(b.size));
+    m.yaw_rad(b.yaw_rad);
+    s.boxes().push_back(m);
+  }
+  s.bounds_min(to_msg(c.bounds_min));
+  s.bounds_max(to_msg(c.bounds_max));
+  s.finish_a(xy(c.finish_a));
+  s.finish_b(xy(c.finish_b));
+  s.goal(xy(c.goal_xy));
+  s.start_center(xy(c.start.center_xy));
+  return s;
+}
+
 }  // namespace ddswarm

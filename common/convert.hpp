@@ -7,7 +7,9 @@
 #include "Geometry.h"
 #include "MissionAck.h"
 #include "MissionCommand.h"
+#include "Scene.h"
 #include "common/mission.hpp"
+#include "common/scene.hpp"
 
 namespace ddswarm {
 
@@ -37,5 +39,13 @@ MissionCommand from_msg(const msg::MissionCommand& m);
 msg::MissionCommand to_msg(const MissionCommand& c);
 
 msg::MissionAck to_msg(const MissionAck& a, std::uint64_t issuer_instance);
+
+/// The world a Scene sample carries: ground, obstacles, bounds, finish line,
+/// goal and the start formation's centre (the rest of StartConfig is the
+/// server's, and start_positions carries where the drones stand).
+SceneConfig from_msg(const msg::Scene& s);
+/// A Scene sample with c's world in it; the server adds what only it knows
+/// (name, seed, instance, rates, drones, sensors).
+msg::Scene to_msg(const SceneConfig& c);
 
 }  // namespace ddswarm

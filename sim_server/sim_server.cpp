@@ -603,7 +603,7 @@ struct SimServer::Impl {
   }
 
   void publish_scene() {
-    msg::Scene s;
+    msg::Scene s = to_msg(cfg.scene);
     s.name(cfg.scenario.name.substr(0, 127));
     s.seed(cfg.scenario.seed);
     s.server_instance(instance);
@@ -611,28 +611,6 @@ struct SimServer::Impl {
     s.mode(cfg.scenario.mode == TimeMode::kLockstep ? msg::MODE_LOCKSTEP : msg::MODE_REALTIME);
     s.physics_rate_hz(cfg.sim.physics_rate_hz);
     s.control_rate_hz(cfg.sim.control_rate_hz);
-    s.ground_z_m(cfg.scene.ground_z_m);
-    for (const auto& c : cfg.scene.cylinders) {
-      msg::Cylinder m;
-      m.x(c.center_xy.x());
-      m.y(c.center_xy.y());
-      m.radius_m(c.radius_m);
-      m.height_m(c.height_m);
-      s.cylinders().push_back(m);
-    }
-    for (const auto& b : cfg.scene.boxes) {
-      msg::Box m;
-      m.center(to_msg(b.center));
-      m.size(to_msg(b.size));
-      m.yaw_rad(b.yaw_rad);
-      s.boxes().push_back(m);
-    }
-    s.bounds_min(to_msg(cfg.scene.bounds_min));
-    s.bounds_max(to_msg(cfg.scene.bounds_max));
-    s.finish_a(to_msg(Eigen::Vector3d(cfg.scene.finish_a.x(), cfg.scene.finish_a.y(), 0)));
-    s.finish_b(to_msg(Eigen::Vector3d(cfg.scene.finish_b.x(), cfg.scene.finish_b.y(), 0)));
-    s.goal(to_msg(Eigen::Vector3d(cfg.scene.goal_xy.x(), cfg.scene.goal_xy.y(), 0)));
-    s.start_center(to_msg(Eigen::Vector3d(cfg.scene.start.center_xy.x(), cfg.scene.start.center_xy.y(), 0)));
     for (const auto& p : starts) s.start_positions().push_back(to_msg(p));
     s.drone_radius_m(cfg.quadrotor.collision_radius_m);
     s.arm_length_m(cfg.quadrotor.arm_length_m);
@@ -792,10 +770,10 @@ struct SimServer::Impl {
                    r.min_inter_drone_m, r.min_clearance_m);
     if (changed && r.phase == TaskPhase::kFailed) spdlog::warn("task failed: {}", r.reason);
   }
-  // A tick published again says which agents are live now. Agents that
-  // joined while the swarm was paused at tick 0 read that tick, built before
-  // they were heard, for as long as the pause lasted: each took its drone's
-  // missing DRONE_AGENT_LIVE for a server that does not hear it, and joined
+  // A tick published again says which agents are live now. Otherwise agents
+  // that join while the swarm is paused at tick 0 read that tick, built before
+  // they were heard, for as long as the pause lasts: each takes its drone's
+  // missing DRONE_AGENT_LIVE for a server that does not hear it, and joins
   // again (agent/agent_app.cpp).
   void refresh_live_flags() {
     std::lock_guard<std::mutex> lock(mu);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "common/convert.hpp"
 #include "common/mission.hpp"
 
 namespace ddswarm::gs::web {
@@ -79,6 +80,8 @@ const char* contact_kind(std::uint8_t kind) {
 }
 
 json vec(const msg::Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+json vec(const Eigen::Vector2d& v) { return json::array({v.x(), v.y(), 0.0}); }
 
 /// nlohmann writes NaN/inf as null; doubles that are finite keep full precision.
 std::string dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
@@ -201,23 +204,24 @@ std::string encode_hello(std::string_view source, std::string_view gs_name) {
 }
 
 std::string encode_scene(const msg::Scene& s) {
+  const SceneConfig world = from_msg(s);
   json cyl = json::array(), box = json::array();
-  for (const auto& c : s.cylinders())
-    cyl.push_back({{"x", c.x()}, {"y", c.y()}, {"r", c.radius_m()}, {"h", c.height_m()}});
-  for (const auto& b : s.boxes()) box.push_back({{"c", vec(b.center())}, {"s", vec(b.size())}, {"yaw", b.yaw_rad()}});
+  for (const auto& c : world.cylinders)
+    cyl.push_back({{"x", c.center_xy.x()}, {"y", c.center_xy.y()}, {"r", c.radius_m}, {"h", c.height_m}});
+  for (const auto& b : world.boxes) box.push_back({{"c", vec(b.center)}, {"s", vec(b.size)}, {"yaw", b.yaw_rad}});
   return dump({{"type", "scene"},
                {"name", s.name().to_string()},
                {"seed", s.seed()},
                {"num_drones", s.num_drones()},
                {"mode", s.mode() == msg::MODE_LOCKSTEP ? "lockstep" : "realtime"},
-               {"ground_z", s.ground_z_m()},
+               {"ground_z", world.ground_z_m},
                {"cylinders", std::move(cyl)},
                {"boxes", std::move(box)},
-               {"bounds_min", vec(s.bounds_min())},
-               {"bounds_max", vec(s.bounds_max())},
-               {"finish_a", vec(s.finish_a())},
-               {"finish_b", vec(s.finish_b())},
-               {"goal", vec(s.goal())},
+               {"bounds_min", vec(world.bounds_min)},
+               {"bounds_max", vec(world.bounds_max)},
+               {"finish_a", vec(world.finish_a)},
+               {"finish_b", vec(world.finish_b)},
+               {"goal", vec(world.goal_xy)},
                {"drone_radius", s.drone_radius_m()},
                {"arm_length", s.arm_length_m()},
                {"sensor_count", s.sensor_count()},

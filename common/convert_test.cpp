@@ -1,0 +1,81 @@
+#include "common/convert.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace ddswarm;
+
+TEST(Convert, ASceneKeepsItsWorldThroughTheWire) {
+  SceneConfig c;
+  c.ground_z_m = -0.5;
+  c.cylinders = {{{3, -4}, 0.6, 9}, {{-12.5, 40}, 1.25, 15}};
+  c.boxes = {{{5, 6, 1.5}, {2, 3, 3}, 0.4}};
+  c.bounds_min = {-80, -20, -0.5};
+  c.bounds_max = {90, 120, 30};
+  c.finish_a = {-40, 55};
+  c.finish_b = {45, 58};
+  c.goal_xy = {2, 66};
+  c.start.center_xy = {1.5, -3};
+  const SceneConfig back = from_msg(to_msg(c));
+  EXPECT_EQ(back.ground_z_m, c.ground_z_m);
+  ASSERT_EQ(back.cylinders.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(back.cylinders[k].center_xy, c.cylinders[k].center_xy);
+    EXPECT_EQ(back.cylinders[k].radius_m, c.cylinders[k].radius_m);
+    EXPECT_EQ(back.cylinders[k].height_m, c.cylinders[k].height_m);
+  }
+  ASSERT_EQ(back.boxes.size(), 1u);
+  EXPECT_EQ(back.boxes[0].center, c.boxes[0].center);
+  EXPECT_EQ(back.boxes[0].size, c.boxes[0].size);
+  EXPECT_EQ(back.boxes[0].yaw_rad, c.boxes[0].yaw_rad);
+  EXPECT_EQ(back.bounds_min, c.bounds_min);
+  EXPECT_EQ(back.bounds_max, c.bounds_max);
+  EXPECT_EQ(back.finish_a, c.finish_a);
+  EXPECT_EQ(back.finish_b, c.finish_b);
+  EXPECT_EQ(back.goal_xy, c.goal_xy);
+  EXPECT_EQ(back.start.center_xy, c.start.center_xy);
+  EXPECT_NO_THROW(back.validate());
+  // What the wire leaves to the server stays unset.
+  EXPECT_TRUE(to_msg(c).name().to_string().empty());
+  EXPECT_EQ(to_msg(c).num_drones(), 0);
+}
+
+TEST(Convert, AMissionCommandAndItsAckKeepEveryField) {
+  MissionCommand c;
+  c.seq = 42;
+  c.type = MissionType::kMove;
+  c.target = 3;
+  c.velocity = {1.5, -0.25, 0.5};
+  c.duration_s = 7.5;
+  c.value = 0.8;
+  c.leader_id = 2;
+  c.epsilon_m = 9;
+  c.issuer = "gs-lab";
+  const msg::MissionCommand m = to_msg(c);
+  EXPECT_EQ(mission_problem(m), "");
+  const MissionCommand back = from_msg(m);
+  EXPECT_EQ(back.seq, c.seq);
+  EXPECT_EQ(back.type, c.type);
+  EXPECT_EQ(back.target, c.target);
+  EXPECT_EQ(back.velocity, c.velocity);
+  EXPECT_EQ(back.duration_s, c.duration_s);
+  EXPECT_EQ(back.value, c.value);
+  EXPECT_EQ(back.leader_id, c.leader_id);
+  EXPECT_EQ(back.epsilon_m, c.epsilon_m);
+  EXPECT_EQ(back.issuer, c.issuer);
+
+  const msg::MissionAck a = to_msg(MissionAck{3, 42, false, "not airborne", Phase::kIdle, 900}, 0xabc);
+  EXPECT_EQ(a.drone_id(), 3);
+  EXPECT_EQ(a.seq(), 42u);
+  EXPECT_FALSE(a.accepted());
+  EXPECT_EQ(a.reason().to_string(), "not airborne");
+  EXPECT_EQ(a.phase(), static_cast<std::uint8_t>(Phase::kIdle));
+  EXPECT_EQ(a.tick(), 900u);
+  EXPECT_EQ(a.issuer_instance(), 0xabcu);
+}
+
+TEST(Convert, VectorsAndAttitudesRoundTripExactly) {
+  const Eigen::Vector3d v(0.1, -2e9, 3.25);
+  EXPECT_EQ(from_msg(to_msg(v)), v);
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  EXPECT_EQ(from_msg(to_msg(q)).coeffs(), q.coeffs());
+}
