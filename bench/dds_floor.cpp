@@ -1,4 +1,4 @@
-// dds_floor: the lockstep floor that Fast DDS sets on this machine (issue 8).
+// dds_floor: the lockstep floor that Fast DDS sets on this machine.
 //
 // One process publishes a whole-swarm msg::SwarmState with N drones and their
 // scans (the size ddswarm's server publishes); N responder processes (this

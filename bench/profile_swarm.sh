@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: where the time goes in a flying swarm. Launches N agent processes
+# Where the time goes in a flying swarm. Launches N agent processes
 # (lockstep or real time), takes off, holds, then samples the server and one
 # agent with perf (cpu-clock, user space) for a few seconds and prints the
 # share of each library and the hottest symbols, plus user/system CPU split.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 6: the recorder keeps up with a 64-drone real-time run (state and
+# The recorder keeps up with a 64-drone real-time run (state and
 # scans at 50 Hz) with zero dropped samples, in bounded memory.
 # Usage: bench/record_bench.sh BIN_DIR [DRONES] [SECONDS] [SCENARIO]
 set -u

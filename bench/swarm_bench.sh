@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8 (scale): ddswarm's lockstep and real-time figures for N agent
+# Scale: ddswarm's lockstep and real-time figures for N agent
 # processes, each beside the bare Fast DDS floor of the same run and beside
 # that floor with a lockstep server's physics between its ticks (the most
 # plain lockstep can tick on the machine), and Table 1's wall time split into
@@ -23,7 +23,7 @@
 #   --streams best-effort|reliable   every part (the floor, lockstep, real time, agent hosts, Table 1):
 #                      how the server reads the commands and the agents the state (writers stay
 #                      reliable) (dds.best_effort_streams; default best-effort, as shipped;
-#                      --rt-streams is the same option, its name before 2026-11-26)
+#                      --rt-streams is the same option under its older name)
 #   --rt-grace G       real time (both): sim.realtime_grace, the share of a period the server waits
 #                      for late answers (default 0.6; the shipped default is 0.25)
 #   --floor-time S     floor seconds measured per N (default 5)

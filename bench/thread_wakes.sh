@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: where the wake-ups go. Launches N agent processes (lockstep by
+# Where the wake-ups go. Launches N agent processes (lockstep by
 # default), takes off, holds, then counts each thread's context switches (voluntary =
 # it slept and was woken; involuntary = preempted) and CPU over a few seconds
 # of ticking, for the server and agent 1, per tick; then every agent's CPU and

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 7: frame rate of the web view with many drones in headless Chromium
+# Frame rate of the web view with many drones in headless Chromium
 # (SwiftShader WebGL, no GPU), at each quality level. By default the drones
 # come from the mock bridge (no DDS: the page's cost alone); with --real, from
 # a real realtime swarm behind ddswarm-gs --web.

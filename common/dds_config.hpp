@@ -56,10 +56,10 @@ constexpr int kAgentParticipantIdBase = 32;
 
 /// The participants' lease (dds.lease_duration_s) in a swarm for which
 /// ddswarm-launch starts a discovery server, unless its scenario names one,
-/// and in bench/dds_floor's discovery-server runs. At the default 3 s, 2 of
-/// about 20 launches of 128 agent processes lost the server for good
+/// and in bench/dds_floor's discovery-server runs. At the default 3 s, about
+/// 1 launch in 10 of 128 agent processes loses the server for good
 /// ("Matching unexisting participant from writer <server>"); at 20 s, none
-/// of 16. A crashed process stays matched in DDS that much longer; ddswarm's
+/// in 16 does. A crashed process stays matched in DDS that much longer; ddswarm's
 /// own timeouts (sim.agent_timeout_s, agent.server_timeout_s) do not depend
 /// on it.
 constexpr double kDiscoveryServerLeaseS = 20.0;
@@ -71,7 +71,7 @@ constexpr double kDiscoveryServerLeaseS = 20.0;
 /// it. In Debian's Fast DDS 2.9.1, a participant that says goodbye just as
 /// that timer fires aborts the peer (PDP.cpp:1140, "GUID_t::unknown() !=
 /// remote_participant->m_guid"): 90 `status` processes of about 3 s each,
-/// against a 3 s lease, aborted 4 agents of 32 once. A command that leaves
+/// against a 3 s lease, can abort 4 agents of 32. A command that leaves
 /// before its lease has passed is never checked, so never races.
 constexpr double kOneShotLeaseS = 20.0;
 
@@ -153,7 +153,7 @@ struct DdsConfig {
   /// every id. Agents set it, so they never discover, and so never
   /// authenticate with, one another; tools, which announce to every id, still
   /// find them. At 24 secure drones the agents' handshakes and key exchanges
-  /// with each other kept the swarm from ever coming up (docs/security.md).
+  /// with each other would keep the swarm from ever coming up (docs/security.md).
   /// Set by the binary, not read from YAML.
   bool announce_to_tools_only = false;
   std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles

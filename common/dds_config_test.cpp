@@ -65,7 +65,7 @@ TEST_F(SecureDir, MissingFilesAreNamedInOneLine) {
 }
 
 // Fast DDS 2.9's discovery server has no DDS Security: a secure client of
-// one aborted on an assertion (SecurityManager.cpp:2272) instead of joining.
+// one aborts on an assertion (SecurityManager.cpp:2272) instead of joining.
 TEST_F(SecureDir, ADiscoveryServerIsRefusedUnderSecurity) {
   auto c = secure("agent-2");
   c.discovery = Discovery::kDiscoveryServer;
@@ -87,8 +87,8 @@ TEST_F(SecureDir, BadOrMissingRoleRejected) {
 }
 
 TEST(OneShotLease, ACommandThatComesAndGoesOutlivesNoPeersLeaseTimer) {
-  // At the default 3 s lease a `status` of about 3 s left as its peers'
-  // timers fired. It announces itself as often as before, every second.
+  // At the default 3 s lease a `status` of about 3 s can leave as its peers'
+  // timers fire. It announces itself as often as at that lease, every second.
   const DdsConfig c = one_shot(DdsConfig{});
   EXPECT_EQ(c.lease_duration_s, kOneShotLeaseS);
   EXPECT_DOUBLE_EQ(c.announcement_period_s, 1.0);

@@ -74,9 +74,9 @@ void load_profiles_once(const std::string& file) {
   if (rc != ReturnCode_t::RETCODE_OK) throw DdsError("cannot load DDS QoS profiles from " + file);
   // Participants of one process talk through their transports, as those of
   // two processes do, whatever the file says: with Fast DDS 2.9.1's
-  // intraprocess delivery, a participant that closed while another in its
-  // process lived on (the ground station's old status snapshot) left a
-  // dangling reader behind, and the process crashed on exit (docs/dds.md).
+  // intraprocess delivery, a participant that closes while another in its
+  // process lives on (such as a ground station's status snapshot) leaves a
+  // dangling reader behind, and the process crashes on exit (docs/dds.md).
   eprosima::fastrtps::LibrarySettingsAttributes lib = eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings();
   lib.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(lib);
@@ -348,21 +348,22 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
   {
     // A new GUID for every participant of this process: Fast DDS 2.9 builds
     // the prefix from the host, the process and the participant id, so an
-    // agent that left DDS and joined again came back under the very GUID it
-    // had left with. Its discovery server then took the new participant's
-    // endpoints for the departed one's ("Writer ... has no associated
-    // participant. Skipping") and never matched them, and the agent had to
-    // re-join again (docs/performance.md). Under DDS Security too: its
-    // authentication derives the prefix from this one, and a secure agent
-    // joins under the same id every time (kAgentParticipantIdBase + K), so
-    // a re-joined agent had the departed one's GUID, and the server's
-    // handshake with it stayed as stalled as before.
+    // agent that leaves DDS and joins again would come back under the very
+    // GUID it left with. Its discovery server would then take the new
+    // participant's endpoints for the departed one's ("Writer ... has no
+    // associated participant. Skipping") and never match them, and the agent
+    // would have to re-join again (docs/performance.md). Under DDS Security
+    // too: its authentication derives the prefix from this one, and a secure
+    // agent joins under the same id every time (kAgentParticipantIdBase + K),
+    // so a re-joined agent would have the departed one's GUID, and the
+    // server's handshake with it would stay as stalled as the old one's.
     auto& pp = process_participants();
     std::lock_guard<std::mutex> lock(pp.mu);
     if (pp.first) qos.wire_protocol().prefix = incarnation_prefix(*pp.first, pp.made);
-    // An automatic id whose shared-memory ports no process left behind: a
-    // server restarted after a SIGKILL came up on its dead predecessor's
-    // ports, and the agents kept sending into the old ones (shm_clean.hpp).
+    // An automatic id whose shared-memory ports no process left behind:
+    // otherwise a server restarted after a SIGKILL comes up on its dead
+    // predecessor's ports, and the agents keep sending into the old ones
+    // (shm_clean.hpp).
     const bool clear_id = cfg.participant_id < 0 && uses_shm_transport(cfg);
     if (clear_id)
       qos.wire_protocol().participant_id = participant_id_clear_of_shm(

@@ -61,8 +61,8 @@ std::uint64_t handler_throws();
 /// with code at once when it has no Fast DDS participant left, after flushing
 /// spdlog, Fast DDS's log and stdio. Fast DDS 2.9's DomainParticipantFactory
 /// sleeps 100 ms in its static destructor, before it stops its log thread;
-/// every ddswarm process paid that as it stopped, a run of Table 1 about half
-/// its teardown. A participant still open at this point returns code for a
+/// every ddswarm process would pay that as it stops, about half of a Table 1
+/// run's teardown. A participant still open at this point returns code for a
 /// normal exit, in which that destructor deletes it and tells its peers.
 /// Sanitizer builds return code too: their checks run at exit.
 int end_process(int code);

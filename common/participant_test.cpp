@@ -512,8 +512,8 @@ class ThrowingType : public fdds::TopicDataType {
 };
 
 // A server whose write throws must not die of it: the write returns false,
-// is counted, and the next write is tried again (issue 9's killed agent,
-// docs/faults.md).
+// is counted, and the next write is tried again (an agent SIGKILLed while it
+// holds its reader's shared-memory lock, docs/faults.md).
 TEST(Participant, AWriteThatThrowsIsCountedAndTheWriterGoesOn) {
   DdsConfig cfg;
   cfg.domain_id = random_test_domain();

@@ -51,9 +51,9 @@ sigset_t signals_of(std::initializer_list<int> sigs) {
 
 // Takes the signals that every other thread blocks. Fast DDS's threads wait
 // on interprocess semaphores, and boost::interprocess throws on EINTR: a
-// SIGTERM handled on one of them ends the process in std::terminate. That
-// happened to an agent sent SIGTERM while stopped (SIGSTOP) and then
-// SIGCONT: a stopped process's signal goes to whichever thread runs first.
+// SIGTERM handled on one of them ends the process in std::terminate. An
+// agent sent SIGTERM while stopped (SIGSTOP) and then SIGCONT is exposed to
+// it: a stopped process's signal goes to whichever thread runs first.
 void take_signals() {
   const sigset_t set = signals_of({SIGINT, SIGTERM, SIGUSR1});
   pthread_sigmask(SIG_BLOCK, &set, nullptr);

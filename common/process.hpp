@@ -59,14 +59,13 @@ void keep_joining(double duration_s, const std::function<bool(double left_s)>& j
 /// its attempt-th try (0 first): base_s, doubled at each try, at most 8 times
 /// base_s. Discovery that is slow because a swarm is coming up must not be
 /// restarted at a fixed pace: every new participant is more discovery work,
-/// and at 128 processes fixed re-joins kept the swarm from ever coming up.
+/// and at 128 processes fixed re-joins keep the swarm from ever coming up.
 double rejoin_patience_s(double base_s, int attempt);
 
 /// Through a discovery server: seconds without hearing the server after which
 /// a tool (ddswarm-gs, bench/swarm_probe) joins again as a new participant,
-/// the base of rejoin_patience_s (a healthy one hears it within 1-2 s; 6 s at
-/// a 128-process bring-up on 2026-11-21, 19-27 s on 2026-11-27's slower
-/// machine).
+/// the base of rejoin_patience_s (a healthy one hears it within 1-2 s; at a
+/// 128-process bring-up, within 6 s, or 19-27 s on a slower machine).
 constexpr double kToolRejoinAfterS = 20.0;
 
 /// Notices that this process was stopped (SIGSTOP, Ctrl-Z, a debugger) or
@@ -93,17 +92,18 @@ class LeaseWatch {
 
 /// Fast DDS 2.9 waits 1 s for an interprocess lock, then throws boost's
 /// "Interprocess mutex timeout when locking. Possible deadlock: owner died
-/// without unlocking?": a process was SIGKILLed while it held a lock in
-/// shared memory. Thrown on one of Fast DDS's own threads, nothing catches it
-/// and the process ends in std::terminate (an agent whose server was killed
-/// while notifying it, docs/faults.md). After this call such an end execs
-/// this program again instead: the same arguments, environment and PID, no
-/// file descriptor but 0-2, and a fresh DDS participant. At most max_restarts
-/// in a row (restarts more than kDeadLockRestartWindowS apart are not in a
-/// row); any other uncaught exception ends the process as before. For a
-/// process whose state its peers give back (an agent catches up with its
-/// mission from the server's samples), not for the server, whose world would
-/// start again. Call it in main, after install_stop_signals.
+/// without unlocking?" when a process SIGKILLed while it held a lock in
+/// shared memory leaves it held. Thrown on one of Fast DDS's own threads,
+/// nothing catches it and the process ends in std::terminate (an agent whose
+/// server is killed while it notifies the agent, docs/faults.md). After this
+/// call such an end execs this program again instead: the same arguments,
+/// environment and PID, no file descriptor but 0-2, and a fresh DDS
+/// participant. At most max_restarts in a row (restarts more than
+/// kDeadLockRestartWindowS apart are not in a row); any other uncaught
+/// exception ends the process as it would without this call. For a process
+/// whose state its peers give back (an agent catches up with its mission from
+/// the server's samples), not for the server, whose world would start again.
+/// Call it in main, after install_stop_signals.
 void restart_on_dead_owner_lock(const char* prog, int argc, char** argv, int max_restarts = 3);
 /// How many times in a row restart_on_dead_owner_lock had started this
 /// process again when it began (0: its first start).

@@ -138,10 +138,10 @@ ShmCleanReport clean_zombie_shm(const std::string& dir, double min_age_s) {
                 !present.count(n + "_sl")) ||
                starts_with(n, "fast_datasharing_")) {
       // No lock tells whether these are in use, only a mapping does. A port
-      // whose owner closed or died took its lock file along: Fast DDS 2.9
-      // leaves the port itself while a sender still counted on it (one file
-      // per SIGKILLed sender piled up by the thousand in /dev/shm on a
-      // machine that ran the tests). A data-sharing pool never has a lock.
+      // whose owner closed or died takes its lock file along: Fast DDS 2.9
+      // leaves the port itself while a sender still counts on it (one file
+      // per SIGKILLed sender, so they pile up by the thousand in /dev/shm on
+      // a machine that runs the tests). A data-sharing pool never has a lock.
       if (is_mapped(n)) {
         ++r.in_use;
         continue;
@@ -159,8 +159,8 @@ ShmCleanReport clean_zombie_shm(const std::string& dir, double min_age_s) {
 int participant_id_clear_of_shm(int domain_id, int max_id, const std::string& dir, int first_id) {
   // A port file, or its owner's lock without the file: a live process whose
   // port Fast DDS removed and never made anew (a sender's "Zombie. Reset the
-  // port" after a stall) still listens there, and a newcomer on that id could
-  // not take its lock: it came up without ports and never heard a scene
+  // port" after a stall) still listens there, and a newcomer on that id cannot
+  // take its lock: it comes up without ports and never hears a scene
   // (docs/dds.md).
   auto held = [&](int port) {
     const std::string path = dir + "/fastrtps_port" + std::to_string(port);

@@ -154,10 +154,10 @@ TEST(ShmClean, ParticipantIdClearOfPortsADeadProcessLeft) {
   EXPECT_EQ(participant_id_clear_of_shm(domain, 119, d.path, 3), 3);
 }
 
-// A live participant whose port file was removed (Fast DDS 2.9 made it anew
-// and removed it again after a stall) still holds its port's lock: a
-// newcomer on that id could not take the lock, came up without ports and
-// never heard the scene. A lock file nobody holds (its owner died) does not count.
+// A live participant whose port file was removed (Fast DDS 2.9 makes it anew
+// and removes it again after a stall) still holds its port's lock: a
+// newcomer on that id cannot take the lock, comes up without ports and
+// never hears the scene. A lock file nobody holds (its owner died) does not count.
 TEST(ShmClean, ParticipantIdClearOfALiveOwnerWhosePortFileWasRemoved) {
   using ddswarm::participant_id_clear_of_shm;
   using ddswarm::rtps_unicast_port;

@@ -29,9 +29,10 @@ inline std::atomic<std::uint64_t>& malformed_samples() {
 /// The generated type support, refusing a malformed sample instead of
 /// throwing. Fast CDR throws BadParamException for, e.g., a bool byte other
 /// than 0 or 1; the generated deserialize() catches only a truncated buffer,
-/// so one such sample from any participant on the domain escaped into Fast
-/// DDS's reader thread and terminated the process. Now deserialize() returns
-/// false (Fast DDS drops the sample) and malformed_samples() counts it.
+/// so one such sample from any participant on the domain would escape into
+/// Fast DDS's reader thread and terminate the process. This deserialize()
+/// returns false instead (Fast DDS drops the sample) and malformed_samples()
+/// counts it.
 template <class Generated>
 class SafePubSub : public Generated {
  public:

@@ -307,7 +307,7 @@ bool DdsCommander::wait_for_swarm(int count, double timeout_s,
 bool DdsCommander::wait_for_online(int count, double timeout_s) {
   // The server's view only: an agent this process hears but the server does
   // not yet would miss the first ticks of a command sent now, and a lockstep
-  // run with the same seed would fly differently (mp_comm_task, 2026-11-28).
+  // run with the same seed would fly differently (mp_comm_task).
   return impl_->wait(timeout_s, [&] { return impl_->server_hears_at_least(count); });
 }
 

@@ -1,7 +1,7 @@
 // The ground station starts a mission only when the server hears every agent:
 // under load, discovery can match an agent with the ground station seconds
 // before it matches the server, and the server releases a command only to
-// the agents it hears (an experiment run once failed so: "takeoff 5/6
+// the agents it hears (otherwise a run fails with "takeoff 5/6
 // acknowledged; no ack from drones 0").
 #include "ground_station/dds_commander.hpp"
 
@@ -118,7 +118,7 @@ TEST(ClimbOver, EitherWordPastTheClimbEndsIt) {
 }
 
 // An experiment's run whose server died at start-up: the wait ends at once,
-// not after its timeout (a minute per run before).
+// not after its timeout (which would cost a minute per run).
 TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
   DdsConfig cfg;
   cfg.domain_id = random_test_domain();
@@ -131,8 +131,8 @@ TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
   EXPECT_FALSE(gs.wait_for_swarm(6, 0.3, [] { return false; }));  // a plain timeout still is one
 }
 
-// A run whose swarm never came up (CI once: the server heard none of six
-// agents the ground station heard) is a start-up failure: the experiment
+// A run whose swarm never came up (e.g. the server hears none of six
+// agents the ground station hears) is a start-up failure: the experiment
 // starts it again, up to kRunStarts times; any other failure is its result.
 TEST(Experiment, ARunWhoseSwarmNeverCameUpStartsAgain) {
   DdsConfig cfg;

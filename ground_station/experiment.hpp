@@ -34,8 +34,8 @@ TaskOutcome swarm_not_up(DdsCommander& gs, int drones, double waited_s,
 /// records the run as failed.
 inline constexpr int kRunStarts = 3;
 /// Whether to start a run again: its swarm never came up (a discovery
-/// failure of Fast DDS, seen once in CI-like runs: the server heard none of
-/// six agents that the ground station heard), no process of it died, and it
+/// failure of Fast DDS, rare but possible: the server hears none of six
+/// agents that the ground station hears), no process of it died, and it
 /// has starts left. A lockstep run's result depends on its seed alone.
 inline bool start_run_again(const TaskOutcome& o, bool a_process_died, int starts) {
   return o.never_up && !a_process_died && starts < kRunStarts;

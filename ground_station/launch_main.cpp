@@ -84,9 +84,8 @@ int run_foreground(const std::vector<std::string>& argv, Launcher& procs,
 
 /// How long --gs waits for the agents before its first step: the bring-up,
 /// plus the longest first join of an agent that heard no scene before it came
-/// back as a new participant. With the default 30 s a launch gave up on an
-/// agent cut off at start-up that would have come back at 40-60 s
-/// (mp_comm_task, 2026-11-29).
+/// back as a new participant. A fixed 30 s would give up on an agent cut off
+/// at start-up that comes back at 40-60 s (mp_comm_task).
 double agents_wait_s(const std::string& scenario) {
   ddswarm::agent::AgentConfig agent;
   try {
@@ -244,8 +243,8 @@ int main(int argc, char** argv) {
       procs.rejoin_dropped_participants("discovery-server");
       // A longer lease for the swarm's own participants, unless the scenario
       // names one: under a 128-process bring-up the discovery server, short of
-      // CPU, drops datagrams, and at the default 3 s it let the server's lease
-      // lapse and lost it for good (docs/performance.md).
+      // CPU, drops datagrams, and at the default 3 s it lets the server's lease
+      // lapse and loses it for good (docs/performance.md).
       // And ground stations patient enough for their own re-join through it
       // (ground_station/main.cpp: after 20 s without a server), which also
       // carries them over a restart of the discovery server (docs/faults.md).
@@ -253,8 +252,8 @@ int main(int argc, char** argv) {
       // sender opening a peer's port waits a third of dds.shm_health_check_s
       // (3.3 s) whenever the port's idle listener was just checked, with
       // every send of its participant held. In 128-process bring-ups the
-      // server stalled 10-20 s that way and lost up to 119 of 128 agents;
-      // over UDP (the swarm state still by data-sharing) it never did
+      // server stalls 10-20 s that way and loses up to 119 of 128 agents;
+      // over UDP (the swarm state still by data-sharing) it does not
       // (docs/dds.md).
       const YAML::Node root = YamlDocument::load_file(scenario).root();
       std::map<std::string, YAML::Node> for_ds;

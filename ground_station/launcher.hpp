@@ -194,7 +194,7 @@ std::vector<std::string> agent_host_shares(const std::vector<int>& ids, int host
 /// started_with_server: the same tool starts the server and every agent of
 /// the swarm, so no other agent flies these drones and the agent skips its
 /// duplicate probe (`--duplicate-probe 0`). N probe readers each matching N
-/// status writers kept a 128-process swarm from coming up at all
+/// status writers keep a 128-process swarm from coming up at all
 /// (docs/performance.md, "Bringing up 128 processes"); agents launched apart
 /// from their server keep it.
 std::vector<std::string> agent_command(const std::string& bin, const std::string& ids, bool host,

@@ -250,8 +250,8 @@ int main(int argc, char** argv) {
     auto file = load_gs_config(config);
     merge_cli(file.dds, dds_cli, app);
     // A ground station is a short-lived process, one per command: over shared
-    // memory a new one took 1.5-3.2 s to hear the server right after another
-    // was killed; over loopback UDP, 0.15-0.25 s (docs/configuration.md).
+    // memory a new one takes 1.5-3.2 s to hear the server right after another
+    // is killed; over loopback UDP, 0.15-0.25 s (docs/configuration.md).
     if (!file.gs.shared_memory) file.dds.shared_memory = false;
     default_security_role(file.dds, "gs");
     validate_with_overrides(config, [&] { file.dds.validate(); });

@@ -12,12 +12,13 @@ constexpr double kSilentSwarmTimeouts = 3.0;
 /// How long (wall s) a live agent may stay silent before the server declares
 /// it lost: agent_timeout_s, or kSilentSwarmTimeouts times that while every
 /// live agent has been silent for kSilentSwarmShare of it, since then the
-/// silence may be the server's own. Fast DDS stalled its receive threads for
-/// over a second while it dropped a killed agent's participant, and every
-/// other agent was declared lost with it. Once, in mp_fault_agent_kill, the
-/// agent heard longest ago, 1 s before, was declared lost with the killed one
-/// and was back 9 ms later (likely the killed agent held the server's
-/// shared-memory port lock, which Fast DDS waits 1 s for; docs/faults.md).
+/// silence may be the server's own. Fast DDS can stall its receive threads
+/// for over a second while it drops a killed agent's participant, and with a
+/// plain timeout every other agent would be declared lost with it. In
+/// mp_fault_agent_kill the agent heard longest ago, 1 s before, can pass the
+/// timeout with the killed one and be back 9 ms later (likely the killed agent
+/// holds the server's shared-memory port lock, which Fast DDS waits 1 s for;
+/// docs/faults.md).
 /// newest_heard_s: when any live agent was last heard.
 double agent_silence_limit(double now_s, double newest_heard_s, double agent_timeout_s);
 
@@ -25,8 +26,9 @@ double agent_silence_limit(double now_s, double newest_heard_s, double agent_tim
 /// another. When a live agent is heard again after one, the samples queued
 /// behind its own come in over the next moments: every live agent's silence
 /// then counts from that moment, not from its last word. In mp_fault_agent_kill
-/// a 1 s stall of the server's port ended with two agents heard, and the
-/// three others, back 4 ms later, had been declared lost at that instant.
+/// a 1 s stall of the server's port can end with two agents heard and the
+/// three others back 4 ms later, which a count from their last word would
+/// declare lost at that instant.
 class SwarmSilence {
  public:
   /// Call at every check: the timeout that applies now (agent_silence_limit).
@@ -55,9 +57,9 @@ constexpr double kPortLockTimeoutS = 1.0;
 /// One alone is. Several at once are most likely one cause, their writes
 /// stalled behind a killed agent's lock on the server's port, not as many
 /// deaths: they wait until the longest silence passes the limit by
-/// kPortLockTimeoutS. In mp_fault_agent_kill (fresh clone, 2026-11-28) four
-/// live agents passed the 1 s limit with the killed one, while a fifth kept
-/// being heard (so the swarm was never silent), and were back 1 ms later.
+/// kPortLockTimeoutS. In mp_fault_agent_kill four live agents can pass the
+/// 1 s limit with the killed one while a fifth keeps being heard (so the
+/// swarm is never silent), and be back 1 ms later.
 bool declare_lost_now(int past_limit, double longest_silence_s, double limit_s);
 
 }  // namespace ddswarm::sim

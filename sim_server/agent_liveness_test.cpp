@@ -14,10 +14,10 @@ TEST(AgentSilence, AServerStallDoesNotLoseTheWholeSwarm) {
 }
 
 TEST(AgentSilence, AStalledPortLosesNoAgentThatWasHeardBeforeIt) {
-  // The server's receive stalled for 1 s (a killed agent held its port's
+  // The server's receive stalls for 1 s (a killed agent holds its port's
   // lock): the other agents silent for 0.7 s, one of them for 1.0 s. The
-  // latter is not lost; with the old rule (the whole swarm silent for a whole
-  // timeout) it was.
+  // latter is not lost, as it would be if only a whole swarm silent for a
+  // whole timeout lengthened the limit.
   EXPECT_GT(agent_silence_limit(10.0, 9.3, 1.0), 1.0);
   // A single dead agent among live ones is still lost after one timeout:
   // the others' heartbeats (4 a second) keep the newest within 0.25 s.
@@ -25,9 +25,9 @@ TEST(AgentSilence, AStalledPortLosesNoAgentThatWasHeardBeforeIt) {
 }
 
 TEST(AgentSilence, AgentsQueuedBehindTheFirstOneHeardAfterAStallAreNotLost) {
-  // mp_fault_agent_kill in a fresh clone: agent 3 killed at t = 9.40, the
-  // server's port stalled until 10.40; agents 1 and 5 came in first, and 0,
-  // 2 and 4 four milliseconds later, each last heard at 9.39 before.
+  // As in mp_fault_agent_kill: agent 3 is killed at t = 9.40, the server's
+  // port stalls until 10.40; agents 1 and 5 come in first, and 0, 2 and 4
+  // four milliseconds later, each last heard at 9.39.
   SwarmSilence watch;
   EXPECT_DOUBLE_EQ(watch.limit(9.80, 9.39, 1.0), 1.0);
   EXPECT_FALSE(watch.silent());
@@ -54,10 +54,10 @@ TEST(AgentSilence, WithoutAStallADeadAgentIsLostAfterOneTimeout) {
 }
 
 TEST(AgentSilence, SeveralAgentsPastTheLimitAtOnceWaitOutAPortStall) {
-  // mp_fault_agent_kill, fresh clone of 2026-11-28: agent 3 killed at 9.65;
-  // agent 4 kept being heard, so the swarm was never silent; agents 0, 1, 2,
-  // 3 and 5, last heard at 9.65, passed the 1 s limit together at 10.656,
-  // and all but 3 were heard again at 10.657.
+  // As in mp_fault_agent_kill: agent 3 is killed at 9.65; agent 4 keeps
+  // being heard, so the swarm is never silent; agents 0, 1, 2, 3 and 5, last
+  // heard at 9.65, pass the 1 s limit together at 10.656, and all but 3 are
+  // heard again at 10.657.
   SwarmSilence watch;
   const double t = watch.limit(10.656, 10.40, 1.0);  // agent 4's heartbeat at 10.40
   EXPECT_DOUBLE_EQ(t, 1.0);

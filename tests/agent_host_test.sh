@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: an agent host (ddswarm-agent --ids) flies many drones' brains in
+# An agent host (ddswarm-agent --ids) flies many drones' brains in
 # one process. The thesis task with all six drones in one host gives exactly
 # the lockstep result of six agent processes (each brain independent, seeing
 # only what its drone receives); a second host cannot claim a drone the

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: an agent that hears no scene within agent.rejoin_after_s leaves DDS
+# An agent that hears no scene within agent.rejoin_after_s leaves DDS
 # and joins again as a new participant (Fast DDS 2.9 sometimes never matches
 # one of 128 processes started at once). Once a server is there, the re-joined
 # agent gets the scene, stops re-joining, and flies its drone.

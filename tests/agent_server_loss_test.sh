@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 3: when the server's samples stop, the agent says so once, stops
+# When the server's samples stop, the agent says so once, stops
 # commanding and waits; when a server comes back it resumes. SIGTERM exits 0.
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/tests/scenarios/one_drone.yaml"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: the scale benches run and print their tables (bench/swarm_bench.sh
+# The scale benches run and print their tables (bench/swarm_bench.sh
 # --quick at tiny N, lockstep at two physics rates). No timed assertion:
 # figures are printed, never judged.
 source "$(dirname "$0")/lib.sh"

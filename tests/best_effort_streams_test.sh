@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: dds.best_effort_streams (on by default) lets the swarm's own readers
+# dds.best_effort_streams (on by default) lets the swarm's own readers
 # of the per-tick streams, the server's of the commands and each agent's of
 # the swarm state, read them best-effort, in both time modes. Writers stay
 # reliable.

@@ -38,7 +38,7 @@ expect_usage_error "gs trace --duration inf" "inf" gs trace --out "$WORK/t.csv" 
 expect_usage_error "gs experiment --set without =" "--set = sim.physics_rate_hz: must be key.path=value" \
   gs experiment "$SRC/config/table1.yaml" --out "$WORK/exp" --set sim.physics_rate_hz
 # A bad value in an experiment's set is found before any run, in well under a second, not after
-# each run's wait for a swarm whose server exited at once (4 runs took 4 minutes before).
+# each run's wait for a swarm whose server exited at once (4 runs would take 4 minutes).
 expect_usage_error "gs experiment --set a bad rate" "set 'Slow': ddswarm-sim: error: $WORK/exp-bad/runs/Slow-00.yaml:8: sim.control_rate_hz = 70: must divide" \
   gs experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$WORK/exp-bad" --set sim.control_rate_hz=70
 expect_usage_error "gs experiment --set an unknown agent key" "set 'Slow': ddswarm-agent: error:" \

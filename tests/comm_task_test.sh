@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 5: with beacons through a communication model (latency, loss, noise),
+# With beacons through a communication model (latency, loss, noise),
 # six agent processes still complete the thesis task in lockstep, and two runs
 # with the same seed give the same result.
 source "$(dirname "$0")/lib.sh"

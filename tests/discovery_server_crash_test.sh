@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: the launcher's discovery server crashed once under a 128-process
+# The launcher's discovery server can crash under a 128-process
 # bring-up (Fast DDS 2.9.1's fast-discovery-server aborts on an assertion in
 # its statistics module; docs/faults.md). The launcher starts it again on the
 # same port, whatever --on-death says, and a swarm in flight does not notice:

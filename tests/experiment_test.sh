@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Issue 4: a short experiment (2 sets x 2 runs, real multi-process lockstep
+# A short experiment (2 sets x 2 runs, real multi-process lockstep
 # runs) produces a CSV, a Markdown table and plot files with the right counts.
-# Issue 8: run two at a time (--jobs 2, each on its own domain), or with each
+# When it runs two at a time (--jobs 2, each on its own domain), or with each
 # run's agents in two agent-host processes (--agent-hosts 2), it gives the very
 # same results, and it says where the wall time went. Every run's server
 # stops cleanly, and no process outlives the experiment. A swarm launched on

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9: an agent is killed (SIGKILL) mid-task. Its drone enters failsafe
+# An agent is killed (SIGKILL) mid-task. Its drone enters failsafe
 # (hovers, then lands after sim.failsafe_land_after_s), lockstep does not
 # deadlock, the other five complete the task and the lost drone is reported.
 # Restarted with the same id, the agent rejoins: it catches up with the
@@ -16,7 +16,7 @@ start trace "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" trace --ou
 sleep 1
 # Lockstep flies the 80 s task in a few seconds of wall time, so kill agent 3
 # the moment it has accepted the task (after a ground station exits is too
-# late: on a loaded machine that took 4 s, and the task was over). Its ack may
+# late: on a loaded machine that takes 4 s, and by then the task is over). Its ack may
 # or may not reach the ground station first: either is fine here.
 start tasksend "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" task --no-wait
 for _ in $(seq 1200); do grep -q "task seq .* accepted" "$WORK/agent3.log" && break; sleep 0.02; done

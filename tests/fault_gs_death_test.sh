@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9: the ground station dies (SIGKILL) mid-task. The swarm completes the
+# The ground station dies (SIGKILL) mid-task. The swarm completes the
 # task it was given, and a new ground station sees the current state and the
 # task's result.
 source "$(dirname "$0")/lib.sh"

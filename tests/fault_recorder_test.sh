@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9: the recorder under SIGTERM and a disk that fills mid-run.
+# The recorder under SIGTERM and a disk that fills mid-run.
 # SIGTERM finalizes like SIGINT: every sample received is in the file.
 # A full disk (a 2 MB tmpfs this test mounts) stops the recording with one
 # clear error naming the file and the counts, exit non-zero, and the file

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9: the server is killed (SIGKILL) mid-task, then restarted. Agents and
+# The server is killed (SIGKILL) mid-task, then restarted. Agents and
 # the ground station notice within about a second and say so; when the server
 # returns (a new world: drones back at their start), the agents reset their
 # mission, the waiting ground station ends the task cleanly (exit 1, reason

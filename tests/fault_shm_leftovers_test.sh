@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9: shared-memory leftovers from crashed processes do not break the
+# Shared-memory leftovers from crashed processes do not break the
 # next run. A whole swarm is killed with SIGKILL (nobody unlinks its
 # segments); the next server clears the zombies (as `fastdds shm clean`
 # does, plus data-sharing pools) and the next swarm flies on the same domain.

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # SIGTERM to a stopped process (Ctrl-Z then kill, or a harness cleaning up)
 # is taken by whichever thread runs first after SIGCONT. Handled on one of
-# Fast DDS's threads, it interrupted an interprocess wait and the process
-# died in std::terminate ("Interrupted system call"), 4 times in 30 for a
+# Fast DDS's threads, it interrupts an interprocess wait and the process
+# dies in std::terminate ("Interrupted system call"), 4 times in 30 for a
 # lone agent. Every process must stop cleanly instead: exit 0, nothing thrown.
-# The signals are now taken on one thread of each process (common/process.hpp).
+# So the signals are taken on one thread of each process (common/process.hpp).
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/config/thesis_course.yaml"
 start sim "$BIN/ddswarm-sim" --scenario "$scenario" --mode realtime --domain "$DOMAIN"

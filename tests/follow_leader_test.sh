@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issues 3 and 4: follow the leader (the thesis's RC drone). Drone 0 is flown
+# Follow the leader (the thesis's RC drone). Drone 0 is flown
 # by velocity commands from the ground station; the others swarm around it.
 source "$(dirname "$0")/lib.sh"
 scenario="$SRC/tests/scenarios/scattered.yaml"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 3: malformed or foreign swarm samples are ignored and counted by the
+# Malformed or foreign swarm samples are ignored and counted by the
 # agent; its drone keeps holding its altitude on the real server's samples,
 # also after another participant republishes the server's scene or publishes
 # one that cannot be flown.

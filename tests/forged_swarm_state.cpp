@@ -1,4 +1,4 @@
-// Issue 3: an agent ignores swarm samples that do not come from its server
+// An agent ignores swarm samples that do not come from its server
 // (forged by another participant: NaN positions, a tick far in the future),
 // counts them, and keeps flying on the real ones. With --copy-scene the forger
 // first republishes the server's own scene, and then plausible states: the

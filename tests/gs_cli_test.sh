@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 4: the ground station's subcommands return 0 when every live agent
+# The ground station's subcommands return 0 when every live agent
 # acknowledged, non-zero on a missing ack or no server; the console runs
 # from scripted stdin (bad input, EOF) against a real swarm.
 source "$(dirname "$0")/lib.sh"

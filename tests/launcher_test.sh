@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 4: the launcher prefixes logs, says which process died and why,
+# The launcher prefixes logs, says which process died and why,
 # applies its policy (stop, keep, restart), and leaves no child behind on a
 # death or on SIGINT.
 source "$(dirname "$0")/lib.sh"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: pipelined lockstep (sim.lockstep_pipeline) flies the thesis task
+# Pipelined lockstep (sim.lockstep_pipeline) flies the thesis task
 # with six agent processes, collision-free, and stays deterministic: two runs
 # with the same seed give the same result to the last digit.
 source "$(dirname "$0")/lib.sh"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: the launcher runs a Fast DDS discovery server for the swarm. Forced
+# The launcher runs a Fast DDS discovery server for the swarm. Forced
 # on for six drones, every child is pointed at it, the lockstep task
 # completes, and the server process is gone when the launcher is; with auto,
 # six drones stay on simple discovery. A swarm with a discovery server leaves

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 7 in a real browser (Debian's chromium, headless, SwiftShader WebGL,
+# The web view in a real browser (Debian's chromium, headless, SwiftShader WebGL,
 # driven by playwright-core): a lockstep swarm, its agents and
 # `ddswarm-gs --web`; tests/web/view_test.mjs checks the page draws as many
 # drones as fly, at their DDS positions within 0.1 m, that its Take off button

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 5: agents on separate machines. Three network namespaces joined by
+# Agents on separate machines. Three network namespaces joined by
 # veth pairs and a bridge act as three hosts with their own addresses: the
 # server (and ground station) on one, agents 0-2 on a second, 3-5 on a third.
 # Shared memory is off, so every sample crosses the bridge over UDP. The task

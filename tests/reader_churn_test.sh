@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Ground-station processes that come and go must neither crash nor stop the
 # swarm (docs/dds.md). Each `status --drones` joins DDS, reads, and leaves, and
-# each leave unmatches its readers from the server's reliable writers. Before,
-# it joined a second participant just to read the swarm state: under load that
-# one missed the state for 3 s (exit 1), or the process crashed as it left
-# (SIGSEGV inside Fast DDS 2.9.1), in 2 runs of this test in 5. Here 32 drones
+# each leave unmatches its readers from the server's reliable writers. It reads
+# the swarm state on its one participant: a second participant joined just for
+# that can miss the state for 3 s under load (exit 1), or crash the process as
+# it leaves (SIGSEGV inside Fast DDS 2.9.1), in 2 runs of this test in 5. Here 32 drones
 # fly a lockstep hold while 90 short-lived `status --drones` processes come and
 # go, three at a time: every one must succeed and the server must keep stepping.
 source "$(dirname "$0")/lib.sh"

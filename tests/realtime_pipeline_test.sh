@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: pipelined real time (sim.realtime_pipeline). Each state goes out on
+# Pipelined real time (sim.realtime_pipeline). Each state goes out on
 # its period's edge and the world steps after it, so an agent has a whole
 # period plus the grace to answer, and every command acts one period later:
 # the probe reads a command age of 2 periods (plain real time: 1) and no

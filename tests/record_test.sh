@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 6: the recorder writes every sample it receives to an MCAP file that
+# The recorder writes every sample it receives to an MCAP file that
 # an independent reader (npm @mcap/core) reads back exactly; SIGINT finalizes;
 # after SIGKILL the file still reads up to its last chunk; a full disk is a
 # clear error; replay reproduces the same sample sequence, and refuses a

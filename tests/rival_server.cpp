@@ -1,4 +1,4 @@
-// Issue 8's "two swarms on one domain": plays a second server whose clock is
+// Two swarms on one domain: plays a second server whose clock is
 // off. It publishes a Scene of its own instance, stamped --clock-offset
 // seconds from now (as a host whose clock is that far off would), and then
 // SimStatus samples of that instance twice a second, with a mission in force

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9, security: a secure agent whose participant never completes its
+# DDS Security: a secure agent whose participant never completes its
 # authentication handshakes (tests/stall_handshake.cpp loses every handshake
 # message its first participant sends, as Fast DDS 2.9 sometimes leaves a
 # server-agent pair pending for good) joins again as a new participant once

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9, security: an agent with credentials for drone 2 cannot command
+# DDS Security: an agent with credentials for drone 2 cannot command
 # drone 3. In a secure 4-drone swarm, agent-2's identity
 #  - is refused a writer in drone 3's partition;
 #  - sends, on its own drone 2 channel, plausible commands for drone 3 that

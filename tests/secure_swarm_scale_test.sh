@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
-# Issue 8 (scale) under DDS Security: a secure swarm of 24 drones, one agent
+# Scale under DDS Security: a secure swarm of 24 drones, one agent
 # process each, comes online and takes off. Agents announce themselves to the
 # server's and tools' participant ids only, so they never authenticate with
-# one another; before, those handshakes and key exchanges (N² of them) kept
-# a 24-drone secure swarm from ever coming up: the server heard 2 of the 24
+# one another; otherwise those handshakes and key exchanges (N² of them) keep
+# a 24-drone secure swarm from ever coming up: the server hears 2 of the 24
 # agents after 90 s (docs/security.md). Also on one host:
 #  - a second secure agent for a flying drone is refused, since that drone's
 #    participant id is taken;
 #  - a discovery server, which Fast DDS 2.9 cannot secure, is refused in one
-#    line (it aborted the swarm's processes before).
+#    line (it would abort the swarm's processes otherwise).
 # A domain whose agents' ports lie below the kernel's ephemeral range, where
 # only a participant binds them, so the duplicate is told for sure.
 DDSWARM_DOMAIN="${DDSWARM_DOMAIN:-$(( (RANDOM % 80) + 20 ))}"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 9, security: a swarm launched with --secure takes off and moves under
+# DDS Security: a swarm launched with --secure takes off and moves under
 # the authenticated ground station, and the recorder's identity records it.
 # A participant without credentials sees no topic and cannot move a drone;
 # the recorder's identity is refused a writer.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Issue 8: an agent's shared-memory outbox is sized for the drones it flies.
+# An agent's shared-memory outbox is sized for the drones it flies.
 # Fast DDS makes each process's transport segment resident in /dev/shm as it
-# starts; at 4 MiB for every process, 128 agents held 540 MB. Now the server
+# starts; at 4 MiB for every process, 128 agents would hold 540 MB. So the server
 # keeps 4 MiB, an agent of one drone 272 KiB and an agent host 16 KiB more per
 # drone, and a six-drone real-time swarm still flies without missing commands.
 source "$(dirname "$0")/lib.sh"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 8: dds.shm_transport: false. Every process leaves out Fast DDS's
+# dds.shm_transport: false. Every process leaves out Fast DDS's
 # shared-memory transport, so no RTPS port of the domain is a file in
 # /dev/shm, while the swarm state still comes by data-sharing (the readers'
 # segments are there); velocity commands go over UDP on 127.0.0.1, and a

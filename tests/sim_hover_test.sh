@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 2: the server and a scripted plain-DDS commander fly one drone to 2 m
+# The server and a scripted plain-DDS commander fly one drone to 2 m
 # and hover within 0.1 m, in both time modes; lockstep reruns are identical.
 source "$(dirname "$0")/lib.sh"
 mode="$1"

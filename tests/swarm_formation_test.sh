@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 3: from a scattered start six agent processes settle with every pair
+# From a scattered start six agent processes settle with every pair
 # farther apart than a safety distance and closer than epsilon; after D_int
 # changes to 6 m the swarm re-forms at the new spacing.
 source "$(dirname "$0")/lib.sh"

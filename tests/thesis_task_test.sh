@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issues 3 and 4: the full thesis task with six agent processes completes in
+# The full thesis task with six agent processes completes in
 # lockstep through the pillar course at the given speed with zero collisions,
 # in bounded wall time; the result is appended to a CSV.
 source "$(dirname "$0")/lib.sh"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 7: `ddswarm-gs --web` streams the live swarm to a WebSocket client
+# `ddswarm-gs --web` streams the live swarm to a WebSocket client
 # (tests/web_client.cpp stands in for the browser): hello, scene and frames
 # with every drone; a takeoff command acknowledged and seen airborne in the
 # frames and in the DDS state; malformed messages answered with `error` while

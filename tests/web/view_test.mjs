@@ -1,4 +1,4 @@
-// Issue 7 in a real browser: the page loads and draws as many drones as fly;
+// The web view in a real browser: the page loads and draws as many drones as fly;
 // each drawn position matches the DDS truth within 0.1 m; clicking Take off
 // makes the swarm airborne by the DDS state; screenshots are saved; the
 // bridge keeps serving after a browser drops mid-stream and after malformed
