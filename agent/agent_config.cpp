@@ -33,14 +33,12 @@ void check_increasing(const std::string& prefix, const std::vector<Eigen::Vector
 
 void ActivationConfig::validate() const {
   const std::string p = "agent.activation";
-  check_positive(p + ".attraction_gain", attraction_gain);
-  check_positive(p + ".repulsion_gain", repulsion_gain);
+  FieldChecker check(p);
+  fields(*this, check);
   if (repulsion_gain < attraction_gain)
     throw FieldError(p + ".repulsion_gain", to_text(repulsion_gain),
                      "must be >= attraction_gain (" + to_text(attraction_gain) +
                          "): repulsion must be the stronger force for the drones' safety");
-  check_positive(p + ".max_mps", max_mps);
-  check_non_negative(p + ".cutoff_m", cutoff_m);
   if (neighbours < 0 || neighbours > kMaxNeighbours)
     throw FieldError(p + ".neighbours", std::to_string(neighbours),
                      "must be 0 (every peer) or 1.." + std::to_string(kMaxNeighbours));
@@ -81,10 +79,8 @@ void ActivationConfig::validate() const {
 
 void SensorFunctionConfig::validate() const {
   const std::string p = "agent.sensor_function";
-  check_positive(p + ".max_mps", max_mps);
-  check_positive(p + ".log_gain_mps", log_gain_mps);
-  check_non_negative(p + ".safety_distance_m", safety_distance_m);
-  check_range(p + ".slide_gain", slide_gain, 0.0, 2.0);
+  FieldChecker check(p);
+  fields(*this, check);
   if (type != SensorFunctionType::kCustom) {
     if (!points.empty())
       throw FieldError(p + ".points", std::to_string(points.size()) + " points",
@@ -123,7 +119,8 @@ void LawConfig::validate() const {
     throw FieldError(path + ".module", module, "only used with type: python");
   if (type != LawType::kPython && !class_name.empty())
     throw FieldError(path + ".class", class_name, "only used with type: python");
-  check_range(path + ".fault_after_s", fault_after_s, 0.0, 3600.0);
+  FieldChecker check(path);
+  fields(*this, check);
   if (fault == Fault::kNone && fault_after_s > 0)
     throw FieldError(path + ".fault_after_s", to_text(fault_after_s), "needs fault: nan or throw");
   law::LawContext ctx;
@@ -167,85 +164,42 @@ void AgentConfig::validate() const {
                          "drone " + std::to_string(id) + " is in an earlier override too");
     o.law.validate();
   }
-  check_range("agent.goal_gain", goal_gain, 1e-6, 5.0);
-  check_positive("agent.inter_distance_m", inter_distance_m);
+  FieldChecker check("agent");
+  fields(*this, check);
   activation.validate();
   if (activation.cutoff_m > 0 && !(activation.cutoff_m > inter_distance_m))
     throw FieldError("agent.activation.cutoff_m", to_text(activation.cutoff_m),
                      "must be 0 (no cutoff) or > inter_distance_m (" + to_text(inter_distance_m) +
                          "), or drones would never attract");
   sensor_function.validate();
-  check_positive("agent.max_speed_mps", max_speed_mps);
-  check_positive("agent.altitude_gain", altitude_gain);
-  check_positive("agent.altitude_tolerance_m", altitude_tolerance_m);
-  check_positive("agent.min_altitude_m", min_altitude_m);
-  check_positive("agent.takeoff_altitude_m", takeoff_altitude_m);
   if (takeoff_altitude_m < min_altitude_m)
     throw FieldError("agent.takeoff_altitude_m", to_text(takeoff_altitude_m),
                      "must be >= min_altitude_m (" + to_text(min_altitude_m) + ")");
   for (auto [name, v] : {std::pair{"agent.takeoff_speed_mps", takeoff_speed_mps},
                          std::pair{"agent.landing_speed_mps", landing_speed_mps},
                          std::pair{"agent.task_speed_mps", task_speed_mps}}) {
-    check_positive(name, v);
     if (v > max_speed_mps)
       throw FieldError(name, to_text(v),
                        "must be <= max_speed_mps (" + to_text(max_speed_mps) + ")");
   }
-  check_positive("agent.teleop_timeout_s", teleop_timeout_s);
-  check_positive("agent.server_timeout_s", server_timeout_s);
-  if (rejoin_after_s != 0) check_range("agent.rejoin_after_s", rejoin_after_s, 2.0, 3600.0);
-  if (handshake_timeout_s != 0)
-    check_range("agent.handshake_timeout_s", handshake_timeout_s, 2.0, 3600.0);
-  check_range("agent.state_loss", state_loss, 0.0, 0.5);
 }
 
 void load(YamlSection s, ActivationConfig& c) {
-  s.get_enum("type", c.type,
-             {{"linear", ActivationType::kLinear}, {"custom", ActivationType::kCustom}});
-  s.get("attraction_gain", c.attraction_gain);
-  s.get("repulsion_gain", c.repulsion_gain);
-  s.get("max_mps", c.max_mps);
-  s.get("points", c.points);
-  s.get("cutoff_m", c.cutoff_m);
-  s.get("neighbours", c.neighbours);
+  FieldLoader load(s);
+  ActivationConfig::fields(c, load);
   s.finish();
 }
 
 void load(YamlSection s, SensorFunctionConfig& c) {
-  s.get_enum("type", c.type,
-             {{"fs1", SensorFunctionType::kFs1},
-              {"fs2", SensorFunctionType::kFs2},
-              {"log", SensorFunctionType::kLog},
-              {"custom", SensorFunctionType::kCustom}});
-  s.get("max_mps", c.max_mps);
-  s.get("log_gain_mps", c.log_gain_mps);
-  s.get("points", c.points);
-  s.get("safety_distance_m", c.safety_distance_m);
-  s.get("slide_gain", c.slide_gain);
+  FieldLoader load(s);
+  SensorFunctionConfig::fields(c, load);
   s.finish();
 }
 
 void load(YamlSection s, LawConfig& c) {
   c.path = s.path();
-  s.get_enum("type", c.type,
-             {{"thesis", LawType::kThesis},
-              {"reynolds", LawType::kReynolds},
-              {"olfati_saber", LawType::kOlfatiSaber},
-              {"vasarhelyi", LawType::kVasarhelyi},
-              {"plugin", LawType::kPlugin},
-              {"python", LawType::kPython}});
-  s.get("library", c.library);
-  s.get("module", c.module);
-  s.get("class", c.class_name);
-  s.get_enum("obstacles", c.obstacles,
-             {{"auto", LawConfig::Obstacles::kAuto},
-              {"law", LawConfig::Obstacles::kLaw},
-              {"framework", LawConfig::Obstacles::kFramework}});
-  s.get_enum("fault", c.fault,
-             {{"none", LawConfig::Fault::kNone},
-              {"nan", LawConfig::Fault::kNaN},
-              {"throw", LawConfig::Fault::kThrow}});
-  s.get("fault_after_s", c.fault_after_s);
+  FieldLoader load(s);
+  LawConfig::fields(c, load);
   YamlSection p = s.child("params");
   if (p.node().IsMap()) {
     for (auto it = p.node().begin(); it != p.node().end(); ++it) {
@@ -280,24 +234,10 @@ void load(YamlSection s, AgentConfig& c) {
     o.finish();
     c.overrides.push_back(std::move(lo));
   }
-  s.get("inter_distance_m", c.inter_distance_m);
   load(s.child("activation"), c.activation);
   load(s.child("sensor_function"), c.sensor_function);
-  s.get("max_speed_mps", c.max_speed_mps);
-  s.get("altitude_hold", c.altitude_hold);
-  s.get("altitude_gain", c.altitude_gain);
-  s.get("altitude_tolerance_m", c.altitude_tolerance_m);
-  s.get("min_altitude_m", c.min_altitude_m);
-  s.get("takeoff_altitude_m", c.takeoff_altitude_m);
-  s.get("takeoff_speed_mps", c.takeoff_speed_mps);
-  s.get("landing_speed_mps", c.landing_speed_mps);
-  s.get("task_speed_mps", c.task_speed_mps);
-  s.get("goal_gain", c.goal_gain);
-  s.get("teleop_timeout_s", c.teleop_timeout_s);
-  s.get("server_timeout_s", c.server_timeout_s);
-  s.get("rejoin_after_s", c.rejoin_after_s);
-  s.get("handshake_timeout_s", c.handshake_timeout_s);
-  s.get("state_loss", c.state_loss);
+  FieldLoader fields(s);
+  AgentConfig::fields(c, fields);
   s.finish();
 }
 

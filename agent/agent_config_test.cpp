@@ -1,4 +1,6 @@
 #include "agent/agent_config.hpp"
+#include "agent/comm_config.hpp"
+#include "common/config_reference.hpp"
 
 #include <gtest/gtest.h>
 
@@ -276,4 +278,15 @@ TEST(AgentConfig, APluginLibraryThatCannotBeFlownIsRefusedWithItsReason) {
                 "ddswarm_law_factory (export the law with DDSWARM_LAW_PLUGIN, docs/laws.md)");
   EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, library: x.so}\n"),
             "s.yaml:2: agent.law.library = x.so: only used with type: plugin");
+}
+
+TEST(AgentConfig, TheReferenceDescribesEveryFieldAsTheCodeDeclaresIt) {
+  const std::string doc = configuration_reference();
+  using Mismatches = std::vector<std::string>;
+  EXPECT_EQ(reference_mismatches(doc, "### `agent:`", field_rows<AgentConfig>()), Mismatches{});
+  EXPECT_EQ(reference_mismatches(doc, "(`agent.activation`)", field_rows<ActivationConfig>()), Mismatches{});
+  EXPECT_EQ(reference_mismatches(doc, "(`agent.sensor_function`)", field_rows<SensorFunctionConfig>()),
+            Mismatches{});
+  EXPECT_EQ(reference_mismatches(doc, "(`agent.law`)", field_rows<LawConfig>()), Mismatches{});
+  EXPECT_EQ(reference_mismatches(doc, "### `comm:`", field_rows<CommConfig>()), Mismatches{});
 }
