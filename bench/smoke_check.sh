@@ -2,7 +2,9 @@
 # The scale benches run and print their tables (bench/swarm_bench.sh
 # --quick at tiny N, lockstep at two physics rates). No timed assertion:
 # figures are printed, never judged.
-source "$(dirname "$0")/lib.sh"
+# Run by scripts/bench --quick (not by the test suite: a benchmark, ~2 min).
+# Usage: DDSWARM_BIN=build/release/bin DDSWARM_SRC=. bench/smoke_check.sh
+source "$(dirname "$0")/../tests/lib.sh"
 start bench bash "$SRC/bench/swarm_bench.sh" --bin "$BIN" --quick --sizes 3 --physics "1000 250" --out "$WORK/out"
 wait_pid "$PID_bench" 400; rc=$?
 out="$WORK/bench.log"
@@ -43,4 +45,5 @@ for who in sim agent; do
 done
 grep -Eq '^all 3 agents, per agent and second of wall time: [0-9.]+ ms of CPU; main thread [0-9.]+ ms in [0-9.]+ runs' \
   "$WORK/wakes.log" || fail "thread_wakes: no line for every agent"
+cat "$out" "$WORK/wakes.log"
 echo PASS
