@@ -6,6 +6,8 @@
 //   static void fields(Self& c, V& v) {
 //     v.field("inter_distance_m", c.inter_distance_m, {"m", positive(), "D_int"});
 //     v.choice("source", c.source, kSources, {"", any(), "where peers come from"});
+//     v.section("start", [&](auto& w) { w.field("spacing_m", c.start.spacing_m, {...}); });
+//     v.list("cylinders", c.cylinders, "pillars");  // each element lists its own fields
 //   }
 //
 // The visitors below turn that list into the loader (FieldLoader: YAML keys
@@ -95,6 +97,25 @@ class FieldLoader {
   void choice(const char* key, E& v, const Choices<E>& names, const FieldSpec&) {
     s_.get_enum(key, v, std::map<std::string, E>(names.begin(), names.end()));
   }
+  /// A nested mapping whose fields list(w) declares.
+  template <class List>
+  void section(const char* key, List&& list) {
+    YamlSection child = s_.child(key);
+    FieldLoader w(child);
+    list(w);
+    child.finish();
+  }
+  /// A sequence of mappings, each an element whose fields E::fields declares.
+  template <class E>
+  void list(const char* key, std::vector<E>& v, const char*) {
+    for (auto child : s_.children(key)) {
+      E e;
+      FieldLoader w(child);
+      E::fields(e, w);
+      child.finish();
+      v.push_back(std::move(e));
+    }
+  }
 
  private:
   YamlSection& s_;
@@ -110,6 +131,18 @@ class FieldChecker {
   }
   template <class E>
   void choice(const char*, const E&, const Choices<E>&, const FieldSpec&) {}
+  template <class List>
+  void section(const char* key, List&& list) {
+    FieldChecker w(prefix_ + "." + key);
+    list(w);
+  }
+  template <class E>
+  void list(const char* key, const std::vector<E>& v, const char*) {
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      FieldChecker w(prefix_ + "." + key + "[" + std::to_string(k) + "]");
+      E::fields(v[k], w);
+    }
+  }
 
  private:
   std::string prefix_;
@@ -142,11 +175,15 @@ class FieldLister {
       def = to_text(v);
     } else if constexpr (std::is_same_v<T, std::string>) {
       def = v;
+    } else if constexpr (requires { v.rows(); v.cols(); }) {  // an Eigen vector
+      type = v.size() == 2 ? "[x, y]" : "[x, y, z]";
+      for (int k = 0; k < v.size(); ++k) def += (k ? ", " : "[") + to_text(v[k]);
+      def += "]";
     } else {  // a list
       type = "list";
       def = v.empty() ? "[]" : "[...]";
     }
-    rows.push_back({key, type, def, spec.unit, spec.bounds.text(), spec.doc});
+    rows.push_back({prefix + key, type, def, spec.unit, spec.bounds.text(), spec.doc});
   }
   template <class E>
   void choice(const char* key, const E& v, const Choices<E>& names, const FieldSpec& spec) {
@@ -155,9 +192,23 @@ class FieldLister {
       type += (type.empty() ? "" : " | ") + name;
       if (value == v) def = name;
     }
-    rows.push_back({key, type, def, spec.unit, "", spec.doc});
+    rows.push_back({prefix + key, type, def, spec.unit, "", spec.doc});
+  }
+  /// A section's fields are rows "key.field".
+  template <class List>
+  void section(const char* key, List&& list) {
+    FieldLister w;
+    w.prefix = prefix + key + ".";
+    list(w);
+    rows.insert(rows.end(), w.rows.begin(), w.rows.end());
+  }
+  /// A list is one row; its elements' fields are the reference's prose.
+  template <class E>
+  void list(const char* key, const std::vector<E>&, const char* doc) {
+    rows.push_back({prefix + key, "list", "[]", "", "", doc});
   }
 
+  std::string prefix;  ///< "" or "section."
   std::vector<FieldRow> rows;
 };
 

@@ -95,7 +95,16 @@ std::vector<std::string> reference_mismatches(const std::string& markdown, const
     const auto& c = it->second;
     const std::string def = plain(c[2]), unit = plain(c[3]), range = plain(c[4]);
     double a = 0, b = 0;
-    const bool same_default = number(def, &a) && number(r.default_text, &b) ? a == b : def == r.default_text;
+    // A placeholder the doc explains ("<source>/config/x.xml") stands for
+    // the start of the code's default.
+    const auto close = def.find('>');
+    const bool placeholder = def.rfind("<", 0) == 0 && close != std::string::npos;
+    const bool same_default =
+        placeholder ? r.default_text.size() >= def.size() - close - 1 &&
+                          r.default_text.compare(r.default_text.size() - (def.size() - close - 1),
+                                                 std::string::npos, def.substr(close + 1)) == 0
+        : number(def, &a) && number(r.default_text, &b) ? a == b
+                                                        : (def == "\"\"" ? "" : def) == r.default_text;
     if (!same_default)
       out.push_back(heading + ": " + r.key + ": the doc's default is '" + def + "', the code's '" +
                     r.default_text + "'");

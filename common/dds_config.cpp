@@ -35,22 +35,8 @@ bool is_local_address(const std::string& ip) {
 }  // namespace
 
 void load(YamlSection s, DdsConfig& c) {
-  s.get("domain_id", c.domain_id);
-  s.get_enum("discovery", c.discovery,
-             {{"localhost", Discovery::kLocalhost},
-              {"interface", Discovery::kInterface},
-              {"peers", Discovery::kPeers},
-              {"discovery_server", Discovery::kDiscoveryServer}});
-  s.get("interface_ip", c.interface_ip);
-  s.get("peers", c.peers);
-  s.get("discovery_server", c.discovery_server);
-  s.get("shared_memory", c.shared_memory);
-  s.get("shm_transport", c.shm_transport);
-  s.get("participant_id", c.participant_id);
-  s.get("lease_duration_s", c.lease_duration_s);
-  s.get("shm_health_check_s", c.shm_health_check_s);
-  s.get("profiles_file", c.profiles_file);
-  s.get("best_effort_streams", c.best_effort_streams);
+  FieldLoader load(s);
+  DdsConfig::fields(c, load);
   s.finish();
 }
 
@@ -86,13 +72,10 @@ void DdsConfig::validate() const {
   } else {
     throw FieldError("dds.profiles_file", profiles_file, "cannot read this file");
   }
-  check_range("dds.domain_id", domain_id, 0, kMaxDomainId);
+  FieldChecker check("dds");
+  fields(*this, check);
   // RTPS ports: 7400 + 250 * domain + 11 + 2 * participant_id must stay below 65536.
   check_range("dds.participant_id", participant_id, -1, max_participant_id(domain_id));
-  if (!(lease_duration_s >= 1.0 && lease_duration_s <= 300.0))
-    throw FieldError("dds.lease_duration_s", to_text(lease_duration_s), "must be in [1, 300]");
-  if (!(shm_health_check_s >= 0.1 && shm_health_check_s <= 60.0))
-    throw FieldError("dds.shm_health_check_s", to_text(shm_health_check_s), "must be in [0.1, 60]");
   if (!(announcement_period_s >= 0.0 && announcement_period_s < lease_duration_s))
     throw FieldError("dds.announcement_period_s", to_text(announcement_period_s),
                      "must be 0 (a third of the lease) or less than dds.lease_duration_s");

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "common/config_fields.hpp"
+
 namespace CLI {
 class App;
 }
@@ -114,13 +116,13 @@ std::uint32_t agent_shm_port_queue(std::size_t drones);
 constexpr double kShmHealthCheckS = 10.0;
 
 struct DdsConfig {
-  int domain_id = 0;                  ///< DDS domain, [0, 232]
+  int domain_id = 0;
   Discovery discovery = Discovery::kLocalhost;
-  std::string interface_ip;           ///< kInterface/kPeers: the local address to use, e.g. 10.10.0.2
-  std::vector<std::string> peers;     ///< kPeers: peer addresses "ip" (or "ip:port" for one port)
-  std::string discovery_server;       ///< kDiscoveryServer: "ip:port" (port default 11811)
-  bool shared_memory = true;          ///< use /dev/shm (see shm_transport)
-  /// With shared_memory: add Fast DDS's shared-memory transport too. false
+  std::string interface_ip;
+  std::vector<std::string> peers;
+  std::string discovery_server;
+  bool shared_memory = true;
+  /// false
   /// keeps data-sharing delivery (the swarm state) and sends every other
   /// sample (velocity commands, statuses, missions) over UDP on 127.0.0.1;
   /// 128 real-time agents then missed fewer commands (docs/performance.md).
@@ -131,12 +133,11 @@ struct DdsConfig {
   /// Messages the shared-memory transport's port holds (this process's
   /// inbox); set by the binary for what it is, not read from YAML.
   std::uint32_t shm_port_queue = kShmPortQueue;
-  int participant_id = -1;            ///< RTPS participant id, -1 = automatic; set explicitly past ~100 participants per host
-                                      ///< (at most max_participant_id(domain_id): the RTPS ports must fit)
-  double lease_duration_s = 3.0;      ///< s: how soon a silent participant is considered gone, > announcement
-  /// s: how long a process may stall while it waits on a shared-memory port
-  /// before the processes that send to it find the port broken and make it
-  /// anew (Fast DDS's healthy_check_timeout, 1 s by default). Fast DDS 2.9
+  /// Set explicitly past ~100 participants per host, at most
+  /// max_participant_id(domain_id): the RTPS ports must fit.
+  int participant_id = -1;
+  double lease_duration_s = 3.0;
+  /// Fast DDS's healthy_check_timeout (1 s by default there). Fast DDS 2.9
   /// makes ports anew with races that can leave a live process listening on
   /// a port no sender reaches any more (docs/dds.md), so ddswarm keeps stalls
   /// shorter than this (a starved CI machine, a server stopped 8 s) off that
@@ -156,11 +157,8 @@ struct DdsConfig {
   /// with each other would keep the swarm from ever coming up (docs/security.md).
   /// Set by the binary, not read from YAML.
   bool announce_to_tools_only = false;
-  std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";  ///< QoS profiles
-  /// Real time only: the swarm's own readers of the per-tick streams, the
-  /// server's of the velocity commands and each agent's of the swarm state,
-  /// read them best-effort: no acknowledgements, as a newer sample supersedes
-  /// a lost one. Writers keep their profile (reliable), so any reliable
+  std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";
+  /// A newer sample supersedes a lost one. Writers keep their profile (reliable), so any reliable
   /// reader (recorder, ground station, web view, a process with false) still
   /// gets every sample, and processes need not agree. Lockstep reads both
   /// streams reliably whatever this says: a tick waits for every state and
@@ -173,6 +171,30 @@ struct DdsConfig {
   /// --security-role: which identity in security_dir to use (server, gs,
   /// recorder, viewer, agent-K); every binary defaults it to what it is.
   std::string security_role;
+
+  /// The fields read from YAML, once (common/config_fields.hpp); the others
+  /// are set by the binary or its command line.
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    static const Choices<Discovery> kDiscovery{{"localhost", Discovery::kLocalhost},
+                                               {"interface", Discovery::kInterface},
+                                               {"peers", Discovery::kPeers},
+                                               {"discovery_server", Discovery::kDiscoveryServer}};
+    v.field("domain_id", c.domain_id, {"", in(0, kMaxDomainId), "DDS domain"});
+    v.choice("discovery", c.discovery, kDiscovery, {"", any(), "how participants find each other"});
+    v.field("interface_ip", c.interface_ip, {"", any(), "interface, peers: this host's address, e.g. 10.10.0.2"});
+    v.field("peers", c.peers, {"", any(), "peers: the peers' addresses, ip or ip:port"});
+    v.field("discovery_server", c.discovery_server, {"", any(), "discovery_server: ip:port (port 11811 if omitted)"});
+    v.field("shared_memory", c.shared_memory, {"", any(), "the shared-memory transport and data-sharing (same host)"});
+    v.field("shm_transport", c.shm_transport, {"", any(), "with shared_memory: Fast DDS's shared-memory transport too"});
+    v.field("participant_id", c.participant_id, {"", any(), "RTPS participant id; -1 = automatic"});
+    v.field("lease_duration_s", c.lease_duration_s, {"s", in(1, 300), "a silent participant is dropped after this"});
+    v.field("shm_health_check_s", c.shm_health_check_s,
+            {"s", in(0.1, 60), "how long a process may stall on a shared-memory port before it is made anew"});
+    v.field("profiles_file", c.profiles_file, {"", any(), "the QoS profiles XML"});
+    v.field("best_effort_streams", c.best_effort_streams,
+            {"", any(), "the swarm's readers of the per-tick streams read them best-effort"});
+  }
 
   void validate() const;  ///< throws FieldError("dds.…")
   bool secure() const { return !security_dir.empty(); }

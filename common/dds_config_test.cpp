@@ -1,4 +1,5 @@
 #include "common/dds_config.hpp"
+#include "common/config_reference.hpp"
 
 #include <gtest/gtest.h>
 
@@ -134,6 +135,11 @@ TEST(DdsConfig, ShmHealthCheckOutOfRangeIsNamed) {
   }
   c.shm_health_check_s = 0.1;
   EXPECT_NO_THROW(c.validate());
+}
+
+TEST(DdsConfig, TheReferenceDescribesEveryFieldAsTheCodeDeclaresIt) {
+  EXPECT_EQ(reference_mismatches(configuration_reference(), "### `dds:`", field_rows<DdsConfig>()),
+            std::vector<std::string>{});
 }
 
 }  // namespace

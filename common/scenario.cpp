@@ -7,16 +7,14 @@ namespace ddswarm {
 const char* to_string(TimeMode m) { return m == TimeMode::kLockstep ? "lockstep" : "realtime"; }
 
 void load(YamlSection s, ScenarioConfig& c) {
-  s.get("name", c.name);
-  s.get("seed", c.seed);
-  s.get("drones", c.drones);
-  s.get_enum("mode", c.mode, {{"realtime", TimeMode::kRealtime}, {"lockstep", TimeMode::kLockstep}});
+  FieldLoader load(s);
+  ScenarioConfig::fields(c, load);
   s.finish();
 }
 
 void ScenarioConfig::validate() const {
-  if (drones < 1 || drones > 1024)
-    throw FieldError("scenario.drones", std::to_string(drones), "must be in [1, 1024]");
+  FieldChecker check("scenario");
+  fields(*this, check);
 }
 
 void check_sections(const YamlDocument& doc) {

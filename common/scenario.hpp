@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <string>
 
+#include "common/config_fields.hpp"
 #include "common/yaml_section.hpp"
 
 namespace ddswarm {
@@ -11,10 +12,20 @@ enum class TimeMode { kRealtime, kLockstep };
 const char* to_string(TimeMode m);
 
 struct ScenarioConfig {
-  std::string name = "unnamed";  ///< shown in logs and results
-  std::uint64_t seed = 1;        ///< seeds sensor noise, random starts and comm models
-  int drones = 6;                ///< number of drones, [1, 1024]
-  TimeMode mode = TimeMode::kRealtime;  ///< realtime: wall-clock paced; lockstep: waits for every agent
+  std::string name = "unnamed";
+  std::uint64_t seed = 1;
+  int drones = 6;
+  TimeMode mode = TimeMode::kRealtime;
+
+  /// Every field once (common/config_fields.hpp).
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    static const Choices<TimeMode> kModes{{"realtime", TimeMode::kRealtime}, {"lockstep", TimeMode::kLockstep}};
+    v.field("name", c.name, {"", any(), "shown in logs and results"});
+    v.field("seed", c.seed, {"", any(), "seeds sensor noise, random starts, comm models and laws"});
+    v.field("drones", c.drones, {"", in(1, 1024), "number of drones, ids 0..drones-1"});
+    v.choice("mode", c.mode, kModes, {"", any(), "realtime: wall-clock paced; lockstep: waits for every agent"});
+  }
 
   void validate() const;
 };

@@ -9,51 +9,14 @@
 namespace ddswarm {
 
 void load(YamlSection s, SceneConfig& c) {
-  s.get("ground_z_m", c.ground_z_m);
-  for (auto o : s.children("cylinders")) {
-    Cylinder cy;
-    o.get("center_xy", cy.center_xy);
-    o.get("radius_m", cy.radius_m);
-    o.get("height_m", cy.height_m);
-    o.finish();
-    c.cylinders.push_back(cy);
-  }
-  for (auto o : s.children("boxes")) {
-    Box b;
-    o.get("center", b.center);
-    o.get("size", b.size);
-    o.get("yaw_rad", b.yaw_rad);
-    o.finish();
-    c.boxes.push_back(b);
-  }
-  s.get("bounds_min", c.bounds_min);
-  s.get("bounds_max", c.bounds_max);
-  auto f = s.child("finish_line");
-  f.get("a", c.finish_a);
-  f.get("b", c.finish_b);
-  f.finish();
-  s.get("goal_xy", c.goal_xy);
-  auto st = s.child("start");
-  st.get_enum("formation", c.start.formation,
-              {{"cluster", Formation::kCluster},
-               {"grid", Formation::kGrid},
-               {"random", Formation::kRandom},
-               {"explicit", Formation::kExplicit}});
-  st.get("center_xy", c.start.center_xy);
-  st.get("spacing_m", c.start.spacing_m);
-  st.get("radius_m", c.start.radius_m);
-  st.get("yaw_rad", c.start.yaw_rad);
-  st.get("positions", c.start.positions);
-  st.finish();
+  FieldLoader load(s);
+  SceneConfig::fields(c, load);
   s.finish();
 }
 
 void SceneConfig::validate() const {
-  for (std::size_t i = 0; i < cylinders.size(); ++i) {
-    std::string p = "scene.cylinders[" + std::to_string(i) + "]";
-    check_positive(p + ".radius_m", cylinders[i].radius_m);
-    check_positive(p + ".height_m", cylinders[i].height_m);
-  }
+  FieldChecker check("scene");
+  fields(*this, check);
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     std::string p = "scene.boxes[" + std::to_string(i) + "]";
     for (int k = 0; k < 3; ++k) check_positive(p + ".size", boxes[i].size[k]);
@@ -69,7 +32,6 @@ void SceneConfig::validate() const {
   if (start.spacing_m < 0.7)
     throw FieldError("scene.start.spacing_m", to_text(start.spacing_m),
                      "must be >= 0.7 (drones would overlap)");
-  check_positive("scene.start.radius_m", start.radius_m);
   // The goal must lie strictly on one side of the finish line.
   Eigen::Vector2d d = finish_b - finish_a;
   Eigen::Vector2d g = goal_xy - finish_a;

@@ -9,22 +9,37 @@
 #include <string>
 #include <vector>
 
+#include "common/config_fields.hpp"
 #include "common/yaml_section.hpp"
 
 namespace ddswarm {
 
 /// A vertical cylinder standing on the ground (the thesis's pillars).
 struct Cylinder {
-  Eigen::Vector2d center_xy{0, 0};  ///< m, ENU
-  double radius_m = 1.0;            ///< m, > 0
-  double height_m = 10.0;           ///< m, > 0
+  Eigen::Vector2d center_xy{0, 0};
+  double radius_m = 1.0;
+  double height_m = 10.0;
+
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.field("center_xy", c.center_xy, {"m", any(), "centre"});
+    v.field("radius_m", c.radius_m, {"m", positive(), "radius"});
+    v.field("height_m", c.height_m, {"m", positive(), "height above the ground"});
+  }
 };
 
 /// A box standing on the ground, rotated about z by yaw.
 struct Box {
-  Eigen::Vector3d center{0, 0, 1};  ///< m, ENU
-  Eigen::Vector3d size{1, 1, 2};    ///< full extents x, y, z in m, each > 0
-  double yaw_rad = 0.0;             ///< rad, rotation about +z
+  Eigen::Vector3d center{0, 0, 1};
+  Eigen::Vector3d size{1, 1, 2};  ///< each > 0 (SceneConfig::validate)
+  double yaw_rad = 0.0;
+
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.field("center", c.center, {"m", any(), "centre (absolute: a box on the ground has z = size.z / 2)"});
+    v.field("size", c.size, {"m", any(), "full extents along the box's own axes"});
+    v.field("yaw_rad", c.yaw_rad, {"rad", any(), "rotation about +z"});
+  }
 };
 
 enum class Formation { kCluster, kGrid, kRandom, kExplicit };
@@ -47,15 +62,43 @@ constexpr double kMinControlRateHz = 1.0;
 constexpr double kMaxControlRateHz = 1000.0;
 
 struct SceneConfig {
-  double ground_z_m = 0.0;                   ///< m, height of the ground plane
+  double ground_z_m = 0.0;
   std::vector<Cylinder> cylinders;
   std::vector<Box> boxes;
-  Eigen::Vector3d bounds_min{-100, -100, 0};  ///< m, world bounds (leaving them is reported)
+  Eigen::Vector3d bounds_min{-100, -100, 0};
   Eigen::Vector3d bounds_max{100, 100, 50};
-  Eigen::Vector2d finish_a{-50, 60};  ///< m, one end of the finish line (xy)
-  Eigen::Vector2d finish_b{50, 60};   ///< m, other end
-  Eigen::Vector2d goal_xy{0, 70};     ///< m, a point past the finish line the task flies to
+  Eigen::Vector2d finish_a{-50, 60};
+  Eigen::Vector2d finish_b{50, 60};
+  Eigen::Vector2d goal_xy{0, 70};
   StartConfig start;
+
+  /// Every field once (common/config_fields.hpp); validate() adds the checks
+  /// that relate fields.
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    static const Choices<Formation> kFormations{{"cluster", Formation::kCluster},
+                                                {"grid", Formation::kGrid},
+                                                {"random", Formation::kRandom},
+                                                {"explicit", Formation::kExplicit}};
+    v.field("ground_z_m", c.ground_z_m, {"m", any(), "height of the ground plane"});
+    v.list("cylinders", c.cylinders, "vertical pillars standing on the ground");
+    v.list("boxes", c.boxes, "boxes");
+    v.field("bounds_min", c.bounds_min, {"m", any(), "world bounds: leaving them is flagged, not prevented"});
+    v.field("bounds_max", c.bounds_max, {"m", any(), "world bounds; above bounds_min and the ground"});
+    v.section("finish_line", [&](auto& w) {
+      w.field("a", c.finish_a, {"m", any(), "one end of the finish line"});
+      w.field("b", c.finish_b, {"m", any(), "other end; != a"});
+    });
+    v.field("goal_xy", c.goal_xy, {"m", any(), "the point the task flies toward and gathers around"});
+    v.section("start", [&](auto& w) {
+      w.choice("formation", c.start.formation, kFormations, {"", any(), "how start positions are made"});
+      w.field("center_xy", c.start.center_xy, {"m", any(), "centre of the formation"});
+      w.field("spacing_m", c.start.spacing_m, {"m", any(), "distance between neighbours; >= 0.7"});
+      w.field("radius_m", c.start.radius_m, {"m", positive(), "disc radius for random"});
+      w.field("yaw_rad", c.start.yaw_rad, {"rad", any(), "initial heading of every drone"});
+      w.field("positions", c.start.positions, {"m", any(), "explicit: one per drone"});
+    });
+  }
 
   void validate() const;  ///< throws FieldError("scene.…")
 

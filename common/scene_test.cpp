@@ -1,4 +1,6 @@
 #include "common/scene.hpp"
+#include "common/config_reference.hpp"
+#include "common/scenario.hpp"
 
 #include <gtest/gtest.h>
 
@@ -42,4 +44,11 @@ TEST(Scene, StartInsideObstacleIsRejected) {
   SceneConfig s;
   s.cylinders.push_back({{0, 0}, 3.0, 10.0});
   EXPECT_THROW(s.start_positions(3, 1), FieldError);
+}
+
+TEST(Reference, TheScenarioAndSceneSectionsDescribeEveryFieldAsTheCodeDeclaresIt) {
+  const std::string doc = configuration_reference();
+  using Mismatches = std::vector<std::string>;
+  EXPECT_EQ(reference_mismatches(doc, "### `scenario:`", field_rows<ScenarioConfig>()), Mismatches{});
+  EXPECT_EQ(reference_mismatches(doc, "### `scene:`", field_rows<SceneConfig>()), Mismatches{});
 }
