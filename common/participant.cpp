@@ -45,8 +45,10 @@ constexpr const char* kLoopback = "127.0.0.1";
 /// Participant ids 0..kInitialPeersRange-1 get unicast discovery pings.
 constexpr int kInitialPeersRange = 120;
 
-/// DDSWARM_FASTDDS_LOG=error|warning|info: how much of Fast DDS's own log a
-/// process prints (to stdout; Fast DDS's default is errors only). Its
+/// DDSWARM_FASTDDS_LOG=off|error|warning|info: how much of Fast DDS's own
+/// log a process prints (to stdout). Off unless asked: ddswarm reports what
+/// matters in its own words, and Fast DDS 2.9 prints errors after runs that
+/// went well (under DDS Security, as a secure participant closes). Its
 /// warnings name what its transports do on their own, such as a shared-memory
 /// port found unhealthy and made anew (docs/dds.md).
 /// Once per process, before its first participant; a bad value throws each time.
@@ -55,13 +57,13 @@ void apply_fastdds_log_env() {
   static std::once_flag once;
   std::call_once(once, [] {
     const char* v = std::getenv("DDSWARM_FASTDDS_LOG");
-    if (!v || !*v) return;
-    const std::string s = v;
-    if (s == "error") Log::SetVerbosity(Log::Error);
+    const std::string s = v ? v : "";
+    if (s.empty() || s == "off") Log::ClearConsumers();
+    else if (s == "error") Log::SetVerbosity(Log::Error);
     else if (s == "warning") Log::SetVerbosity(Log::Warning);
     else if (s == "info") Log::SetVerbosity(Log::Info);
     else
-      throw DdsError("DDSWARM_FASTDDS_LOG: '" + s + "' is not one of error, warning, info");
+      throw DdsError("DDSWARM_FASTDDS_LOG: '" + s + "' is not one of off, error, warning, info");
   });
 }
 

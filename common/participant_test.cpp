@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <stdexcept>
 
@@ -51,6 +52,21 @@ TEST(Participant, EveryJoinOfAProcessHasItsOwnGuid) {
   // bytes), and the participant id where Fast DDS puts it.
   EXPECT_TRUE(std::equal(first.value, first.value + 9, second.value));
   EXPECT_TRUE(std::equal(first.value, first.value + 9, third.value));
+}
+
+TEST(Participant, FastDdsOwnLogIsSilentUnlessAsked) {
+  // The suite runs it unset; DDSWARM_FASTDDS_LOG=error shows the test can fail.
+  const char* env = std::getenv("DDSWARM_FASTDDS_LOG");
+  const bool asked = env && std::string(env) != "off";
+  DdsConfig cfg;
+  cfg.domain_id = random_test_domain();
+  join_and_leave(cfg);  // the first participant sets the log up
+  testing::internal::CaptureStdout();
+  testing::internal::CaptureStderr();
+  EPROSIMA_LOG_ERROR(DDSWARM_TEST, "an error Fast DDS would print");
+  eprosima::fastdds::dds::Log::Flush();
+  const std::string out = testing::internal::GetCapturedStdout() + testing::internal::GetCapturedStderr();
+  EXPECT_EQ(out.find("an error Fast DDS would print") != std::string::npos, asked) << out;
 }
 
 TEST(Participant, IncarnationPrefixKeepsHostAndProcess) {

@@ -50,7 +50,7 @@ out=$(DDSWARM_FASTDDS_LOG=loud timeout 10 "$BIN/ddswarm-gs" --domain "$DOMAIN" s
 rc=$?
 echo "DDSWARM_FASTDDS_LOG=loud: exit $rc after $((SECONDS - t0)) s: $out"
 { [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ $((SECONDS - t0)) -le 3 ] &&
-  echo "$out" | grep -qF "DDSWARM_FASTDDS_LOG: 'loud' is not one of error, warning, info"; } ||
+  echo "$out" | grep -qF "DDSWARM_FASTDDS_LOG: 'loud' is not one of off, error, warning, info"; } ||
   problems+=("DDSWARM_FASTDDS_LOG=loud: exit $rc, '$out'")
 for b in sim agent; do
   flag=--scenario; [ $b = agent ] && flag=--config
