@@ -17,6 +17,7 @@ void load(YamlSection s, SceneConfig& c) {
 void SceneConfig::validate() const {
   FieldChecker check("scene");
   fields(*this, check);
+  generate.validate();
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     std::string p = "scene.boxes[" + std::to_string(i) + "]";
     for (int k = 0; k < 3; ++k) check_positive(p + ".size", boxes[i].size[k]);

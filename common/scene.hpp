@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/config_fields.hpp"
+#include "common/world_gen.hpp"
 #include "common/yaml_section.hpp"
 
 namespace ddswarm {
@@ -71,6 +72,8 @@ struct SceneConfig {
   Eigen::Vector2d finish_b{50, 60};
   Eigen::Vector2d goal_xy{0, 70};
   StartConfig start;
+  /// Obstacles the server adds from a seed (common/world_gen.hpp).
+  WorldGenConfig generate;
 
   /// Every field once (common/config_fields.hpp); validate() adds the checks
   /// that relate fields.
@@ -98,6 +101,7 @@ struct SceneConfig {
       w.field("yaw_rad", c.start.yaw_rad, {"rad", any(), "initial heading of every drone"});
       w.field("positions", c.start.positions, {"m", any(), "explicit: one per drone"});
     });
+    v.section("generate", [&](auto& w) { WorldGenConfig::fields(c.generate, w); });
   }
 
   void validate() const;  ///< throws FieldError("scene.…")
