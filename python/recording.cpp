@@ -2,7 +2,7 @@
 // (ddswarm-record's), decoded with the project's own CDR types, each field a
 // column: a number per sample is an array (T,), a Vec3 (T, 3), a field inside
 // a sequence of structs (T, N, ...) with N the longest sequence (shorter
-// ones padded: NaN, or 0 for 64-bit integers and booleans).
+// ones padded: NaN, or 0 for 64-bit integers, false for booleans).
 #include "python/recording.hpp"
 
 #include <array>
@@ -11,6 +11,7 @@
 #include <map>
 #include <stdexcept>
 #include <type_traits>
+#include <unordered_map>
 
 #include "common/mcap/mcap_reader.hpp"
 #include "common/swarm_state_cdr.hpp"
@@ -24,177 +25,175 @@ namespace {
 
 enum class Kind { kFloat, kU64, kI64, kBool, kText };
 
-/// One field's values over the samples.
+/// One field's column: its layout, found in a first pass over the samples,
+/// then its array, filled in a second.
 struct Column {
+  std::string name;  ///< "drones.position"
   Kind kind = Kind::kFloat;
   int width = 1;  ///< components per value: 3 for a Vec3, 4 for a Quat or float[4]
   int depth = 0;  ///< sequences around the value
-  std::array<std::size_t, 2> extent{0, 0};  ///< longest sequence at each depth
-  struct Cell {
-    std::size_t sample;
-    std::array<std::size_t, 2> at;
-    std::size_t first;  ///< index of its first component in values / texts
-  };
-  std::vector<Cell> cells;
-  std::vector<double> f;
-  std::vector<std::uint64_t> u;
-  std::vector<std::int64_t> i;
-  std::vector<std::string> texts;
+  std::array<std::size_t, 2> extent{0, 0};  ///< the longest sequence at each depth
+  py::object array;  ///< numpy array, or a list of str
+  void* data = nullptr;
 };
 
-/// The visitor message_visit.hpp's functions call: puts each field of the
-/// current sample into its column.
+/// The visitor message_visit.hpp's functions call. In the first pass
+/// (fill = false) it learns every column's kind, width, depth and extents;
+/// in the second it writes each value where it belongs. Columns are found
+/// by (enclosing prefix, field name literal), not by building names.
 class Columns {
  public:
+  bool fill = false;
   std::size_t sample = 0;
 
   template <class T>
   void value(const char* name, const T& x) {
     if constexpr (std::is_same_v<T, bool>)
-      put(name, Kind::kBool, 1, [&](Column& c) { c.u.push_back(x ? 1 : 0); });
+      put(name, Kind::kBool, 1, [&](Column& c, std::size_t o) { static_cast<bool*>(c.data)[o] = x; });
     else if constexpr (std::is_integral_v<T> && sizeof(T) == 8 && std::is_unsigned_v<T>)
-      put(name, Kind::kU64, 1, [&](Column& c) { c.u.push_back(x); });
+      put(name, Kind::kU64, 1, [&](Column& c, std::size_t o) { static_cast<std::uint64_t*>(c.data)[o] = x; });
     else if constexpr (std::is_integral_v<T> && sizeof(T) == 8)
-      put(name, Kind::kI64, 1, [&](Column& c) { c.i.push_back(x); });
+      put(name, Kind::kI64, 1, [&](Column& c, std::size_t o) { static_cast<std::int64_t*>(c.data)[o] = x; });
     else
-      put(name, Kind::kFloat, 1, [&](Column& c) { c.f.push_back(static_cast<double>(x)); });
+      put(name, Kind::kFloat, 1, [&](Column& c, std::size_t o) { static_cast<double*>(c.data)[o] = static_cast<double>(x); });
   }
   template <class S>
   void text(const char* name, const S& s) {
-    std::string t;
-    if constexpr (std::is_same_v<S, std::string>) t = s;
-    else t = s.to_string();
-    put(name, Kind::kText, 1, [&](Column& c) { c.texts.push_back(std::move(t)); });
+    put(name, Kind::kText, 1, [&](Column& c, std::size_t) {
+      std::string t;
+      if constexpr (std::is_same_v<S, std::string>) t = s;
+      else t = s.to_string();
+      py::list l = c.array;
+      if (c.depth == 0) l[sample] = py::str(t);
+      else py::list(l[sample]).append(py::str(t));
+    });
   }
   template <class T, std::size_t N>
   void array(const char* name, const std::array<T, N>& a) {
-    put(name, Kind::kFloat, static_cast<int>(N), [&](Column& c) {
-      for (const auto& x : a) c.f.push_back(static_cast<double>(x));
+    put(name, Kind::kFloat, static_cast<int>(N), [&](Column& c, std::size_t o) {
+      for (std::size_t k = 0; k < N; ++k) static_cast<double*>(c.data)[o + k] = static_cast<double>(a[k]);
     });
   }
   void vector(const char* name, const msg::Vec3& v) {
-    put(name, Kind::kFloat, 3, [&](Column& c) { c.f.insert(c.f.end(), {v.x(), v.y(), v.z()}); });
+    put(name, Kind::kFloat, 3, [&](Column& c, std::size_t o) {
+      double* d = static_cast<double*>(c.data) + o;
+      d[0] = v.x(), d[1] = v.y(), d[2] = v.z();
+    });
   }
   void vector(const char* name, const msg::Quat& q) {
-    put(name, Kind::kFloat, 4, [&](Column& c) { c.f.insert(c.f.end(), {q.w(), q.x(), q.y(), q.z()}); });
+    put(name, Kind::kFloat, 4, [&](Column& c, std::size_t o) {
+      double* d = static_cast<double*>(c.data) + o;
+      d[0] = q.w(), d[1] = q.x(), d[2] = q.y(), d[3] = q.z();
+    });
   }
   template <class S>
   void nested(const char* name, const S& s) {
-    const std::size_t keep = prefix_.size();
-    prefix_ += std::string(name) + ".";
+    const int keep = prefix_;
+    prefix_ = prefix(name);
     wire::visit(s, *this);
-    prefix_.resize(keep);
+    prefix_ = keep;
   }
   template <class T>
   void sequence(const char* name, const std::vector<T>& seq) {
     if (depth_ >= 2) throw std::runtime_error(std::string("a sequence three deep: ") + name);
-    const std::size_t keep = prefix_.size();
+    const int keep = prefix_;
+    if constexpr (!std::is_arithmetic_v<T>) prefix_ = prefix(name);
     for (std::size_t k = 0; k < seq.size(); ++k) {
-      at_[depth_] = k;
-      ++depth_;
-      if constexpr (std::is_arithmetic_v<T>) {
-        value(name, seq[k]);
-      } else {
-        prefix_ += std::string(name) + ".";
-        wire::visit(seq[k], *this);
-        prefix_.resize(keep);
-      }
+      at_[depth_++] = k;
+      if constexpr (std::is_arithmetic_v<T>) value(name, seq[k]);
+      else wire::visit(seq[k], *this);
       --depth_;
     }
     at_[depth_] = 0;
-    if (seq.empty()) touch(name);
+    prefix_ = keep;
   }
 
-  /// Each column as a numpy array (text: a list of str), samples first.
-  py::dict to_python(std::size_t samples) const {
-    py::dict out;
-    for (const auto& name : order_) {
-      const Column& c = columns_.at(name);
+  /// After the first pass: every column's array, padded, samples first.
+  void allocate(std::size_t samples) {
+    samples_ = samples;
+    for (auto& c : columns_) {
       std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(samples)};
       for (int d = 0; d < c.depth; ++d) shape.push_back(static_cast<py::ssize_t>(c.extent[d]));
       if (c.width > 1) shape.push_back(c.width);
-      std::size_t per_sample = 1;
-      for (std::size_t k = 1; k < shape.size(); ++k) per_sample *= static_cast<std::size_t>(shape[k]);
-      auto offset = [&](const Column::Cell& cell) {
-        std::size_t o = cell.sample;
-        for (int d = 0; d < c.depth; ++d) o = o * c.extent[d] + cell.at[d];
-        return o * static_cast<std::size_t>(c.width);
-      };
-      if (c.kind == Kind::kText) {
-        if (c.depth == 0 && c.width == 1) {
+      std::size_t n = 1;
+      for (auto x : shape) n *= static_cast<std::size_t>(x);
+      switch (c.kind) {
+        case Kind::kText: {
           py::list l(samples);
-          for (const auto& cell : c.cells) l[cell.sample] = c.texts[cell.first];
-          out[name.c_str()] = l;
-        } else {
-          py::list l;  // text inside sequences: one list per sample, in order
-          std::vector<py::list> per(samples);
-          for (const auto& cell : c.cells) per[cell.sample].append(c.texts[cell.first]);
-          for (auto& p : per) l.append(p);
-          out[name.c_str()] = l;
+          if (c.depth > 0)
+            for (std::size_t k = 0; k < samples; ++k) l[k] = py::list();
+          c.array = l;
+          break;
         }
-        continue;
-      }
-      auto fill = [&](auto* data, auto pad, const auto& src) {
-        std::fill(data, data + samples * per_sample, pad);
-        for (const auto& cell : c.cells)
-          for (int w = 0; w < c.width; ++w) data[offset(cell) + w] = src[cell.first + w];
-      };
-      if (c.kind == Kind::kFloat) {
-        py::array_t<double> a(shape);
-        fill(a.mutable_data(), std::numeric_limits<double>::quiet_NaN(), c.f);
-        out[name.c_str()] = a;
-      } else if (c.kind == Kind::kU64) {
-        py::array_t<std::uint64_t> a(shape);
-        fill(a.mutable_data(), std::uint64_t{0}, c.u);
-        out[name.c_str()] = a;
-      } else if (c.kind == Kind::kI64) {
-        py::array_t<std::int64_t> a(shape);
-        fill(a.mutable_data(), std::int64_t{0}, c.i);
-        out[name.c_str()] = a;
-      } else {
-        py::array_t<bool> a(shape);
-        bool* d = a.mutable_data();
-        std::fill(d, d + samples * per_sample, false);
-        for (const auto& cell : c.cells) d[offset(cell)] = c.u[cell.first] != 0;
-        out[name.c_str()] = a;
+        case Kind::kFloat: c.array = alloc<double>(c, shape, n, std::numeric_limits<double>::quiet_NaN()); break;
+        case Kind::kU64: c.array = alloc<std::uint64_t>(c, shape, n, 0); break;
+        case Kind::kI64: c.array = alloc<std::int64_t>(c, shape, n, 0); break;
+        case Kind::kBool: c.array = alloc<bool>(c, shape, n, false); break;
       }
     }
+    fill = true;
+  }
+
+  py::dict to_python() const {
+    py::dict out;
+    for (const auto& c : columns_) out[c.name.c_str()] = c.array;
     return out;
   }
 
  private:
-  Column& column(const std::string& full, Kind kind, int width) {
-    auto it = columns_.find(full);
-    if (it == columns_.end()) {
-      it = columns_.emplace(full, Column{}).first;
-      it->second.kind = kind;
-      it->second.width = width;
-      it->second.depth = depth_;
-      order_.push_back(full);
+  struct KeyHash {
+    std::size_t operator()(const std::pair<int, const char*>& k) const {
+      return std::hash<const void*>()(k.second) ^ (static_cast<std::size_t>(k.first) * 0x9e3779b97f4a7c15ULL);
     }
-    return it->second;
+  };
+  using Key = std::pair<int, const char*>;
+
+  template <class T>
+  py::array_t<T> alloc(Column& c, const std::vector<py::ssize_t>& shape, std::size_t n, T pad) {
+    py::array_t<T> a(shape);
+    std::fill(a.mutable_data(), a.mutable_data() + n, pad);
+    c.data = a.mutable_data();
+    return a;
   }
-  /// An empty sequence still names its column (of extent 0 so far).
-  void touch(const char* name) {
-    (void)name;
+  /// The prefix id of field `name` inside the current prefix.
+  int prefix(const char* name) {
+    const Key k{prefix_, name};
+    auto it = prefixes_.find(k);
+    if (it != prefixes_.end()) return it->second;
+    prefix_names_.push_back(prefix_names_[prefix_] + name + ".");
+    return prefixes_[k] = static_cast<int>(prefix_names_.size()) - 1;
   }
-  template <class Put>
-  void put(const char* name, Kind kind, int width, Put&& put_values) {
-    Column& c = column(prefix_ + name, kind, width);
-    const std::size_t first = kind == Kind::kText ? c.texts.size()
-                              : kind == Kind::kFloat ? c.f.size()
-                              : kind == Kind::kI64   ? c.i.size()
-                                                     : c.u.size();
-    c.cells.push_back({sample, at_, first});
-    for (int d = 0; d < c.depth; ++d) c.extent[d] = std::max(c.extent[d], at_[d] + 1);
-    put_values(c);
+  template <class Write>
+  void put(const char* name, Kind kind, int width, Write&& write) {
+    const Key k{prefix_, name};
+    auto it = ids_.find(k);
+    if (!fill) {
+      if (it == ids_.end()) {
+        Column c;
+        c.name = prefix_names_[prefix_] + name;
+        c.kind = kind;
+        c.width = width;
+        c.depth = depth_;
+        columns_.push_back(std::move(c));
+        it = ids_.emplace(k, static_cast<int>(columns_.size()) - 1).first;
+      }
+      Column& c = columns_[it->second];
+      for (int d = 0; d < c.depth; ++d) c.extent[d] = std::max(c.extent[d], at_[d] + 1);
+      return;
+    }
+    Column& c = columns_[it->second];
+    std::size_t o = sample;
+    for (int d = 0; d < c.depth; ++d) o = o * c.extent[d] + at_[d];
+    write(c, o * static_cast<std::size_t>(c.width));
   }
 
-  std::string prefix_;
+  int prefix_ = 0;
+  std::vector<std::string> prefix_names_{""};
+  std::unordered_map<Key, int, KeyHash> prefixes_, ids_;
   std::array<std::size_t, 2> at_{0, 0};
   int depth_ = 0;
-  std::map<std::string, Column> columns_;
-  std::vector<std::string> order_;
+  std::size_t samples_ = 0;
+  std::vector<Column> columns_;
 };
 
 /// Deserialises one recorded CDR payload (encapsulation header included).
@@ -267,22 +266,30 @@ py::dict read_topic(const std::string& path, const std::string& topic) {
     std::vector<double> log_time_s;
     std::size_t rejected = 0;
     const std::uint64_t start = r->statistics().message_start_time_ns;
-    try {
+    // Two passes over the file: the columns' layout, then their values, so
+    // no value is held twice.
+    auto pass = [&](bool fill) {
+      std::size_t n = 0;
       r->for_each_message([&](const mcap::MessageView& m) {
         if (std::find(ids.begin(), ids.end(), m.channel_id) == ids.end()) return;
         T sample;
         if (!from_cdr(m.data, sample)) {
-          ++rejected;
+          if (!fill) ++rejected;
           return;
         }
-        cols.sample = log_time_s.size();
+        cols.sample = n++;
         wire::visit(sample, cols);
-        log_time_s.push_back(static_cast<double>(m.log_time_ns - start) * 1e-9);
+        if (!fill) log_time_s.push_back(static_cast<double>(m.log_time_ns - start) * 1e-9);
       });
+    };
+    try {
+      pass(false);
+      cols.allocate(log_time_s.size());
+      pass(true);
     } catch (const std::exception& e) {
       throw py::value_error(e.what());
     }
-    out = cols.to_python(log_time_s.size());
+    out = cols.to_python();
     py::array_t<double> t(static_cast<py::ssize_t>(log_time_s.size()));
     std::copy(log_time_s.begin(), log_time_s.end(), t.mutable_data());
     out["log_time_s"] = t;
