@@ -387,7 +387,8 @@ void PhysicsWorld::step(double dt) {
     }
     btRigidBody& body = *d.body;
     const Eigen::Matrix3d r = to_eigen(body.getWorldTransform().getBasis());
-    const Eigen::Vector3d v_b = r.transpose() * to_eigen(body.getLinearVelocity());
+    // Drag acts on the airspeed: the velocity relative to the air (the wind).
+    const Eigen::Vector3d v_b = r.transpose() * (to_eigen(body.getLinearVelocity()) - d.air_world);
     const Eigen::Vector3d w_b = r.transpose() * to_eigen(body.getAngularVelocity());
     Eigen::Vector3d force_b = -c_quad.cwiseProduct(v_b.cwiseProduct(v_b.cwiseAbs())) - c_lin * v_b;
     force_b.z() += thrust;

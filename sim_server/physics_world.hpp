@@ -78,6 +78,11 @@ class PhysicsWorld {
   /// the first-order motor lag is applied inside step(). Held until changed.
   void set_rotor_commands(int drone, const std::array<double, 4>& omega_cmd_rad_s);
 
+  /// The air's velocity at the drone (m/s, world ENU: the wind, sim/wind.hpp);
+  /// body drag acts on the velocity relative to it. Held until changed; calm
+  /// (zero) at start.
+  void set_air_velocity(int drone, const Eigen::Vector3d& air_world) { drones_[drone].air_world = air_world; }
+
   /// Advances one fixed step of dt seconds: motor lag, rotor thrust k_f w^2 at
   /// the rotor hubs along body z, reaction torques -+k_m w^2 about body z,
   /// body drag, gravity, contacts. Then records the contacts that began.
@@ -131,6 +136,7 @@ class PhysicsWorld {
     std::unique_ptr<btRigidBody> body;
     std::array<double, 4> omega_cmd{};
     std::array<double, 4> omega{};
+    Eigen::Vector3d air_world{0, 0, 0};
   };
   /// A pair touching in this step's manifolds.
   struct PairContact {

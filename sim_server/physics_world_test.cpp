@@ -115,6 +115,44 @@ TEST(PhysicsWorld, VerticalDragGivesTerminalVelocity) {
   EXPECT_NEAR(-w.state(0).v_world.z(), terminal, 0.02 * terminal);
 }
 
+TEST(PhysicsWorld, ADroneAdriftInTheWindReachesItsSpeed) {
+  // Thrust carries the weight; drag on the airspeed pushes the drone until
+  // it moves with the air.
+  QuadrotorParams q;
+  PhysicsWorld w(empty_scene(), q, {{0, 0, 0}}, 0.0);
+  w.reset_drone(0, {0, 0, 50}, 0.0);
+  const double h = q.hover_omega();
+  w.set_rotor_commands(0, {h, h, h, h});
+  w.set_air_velocity(0, {5, 0, 0});
+  step_for(w, 0.1);
+  // Early on: the drag force c v^2 + c_lin v at 5 m/s of airspeed.
+  const double v0 = w.state(0).v_world.x();
+  step_for(w, 0.1);
+  const double force = q.drag_quadratic_body.x() * 25 + q.drag_linear_n_per_mps * 5;
+  EXPECT_NEAR((w.state(0).v_world.x() - v0) / 0.1 * q.mass_kg, force, 0.05 * force);
+  // Then the airspeed decays as quadratic drag says: dv/dt = -(c/m) v^2, so
+  // v(T) = v(0) / (1 + (c/m) v(0) T): the drone tends to the wind's speed.
+  ASSERT_EQ(q.drag_linear_n_per_mps, 0.0);
+  const double rel0 = 5.0 - w.state(0).v_world.x();
+  step_for(w, 60.0);
+  const double rel = rel0 / (1 + q.drag_quadratic_body.x() / q.mass_kg * rel0 * 60.0);
+  EXPECT_NEAR(5.0 - w.state(0).v_world.x(), rel, 0.02 * rel);
+  EXPECT_NEAR(w.state(0).v_world.y(), 0.0, 1e-6);
+}
+
+TEST(PhysicsWorld, AHoveringDroneHoldsItsPlaceInASteadyWind) {
+  // The velocity controller's integrator takes the drag: after settling, a
+  // drone asked to stay (zero velocity) in 5 m/s of wind holds its place.
+  Swarm s(empty_scene(), {{0, 0, 0}});
+  s.take_off(2.0);
+  s.world.set_air_velocity(0, {5, 0, 0});
+  s.run(10.0);  // the integrator settles
+  const Eigen::Vector3d p = s.world.state(0).p_world;
+  s.run(20.0);
+  EXPECT_LT((s.world.state(0).p_world - p).norm(), 0.10) << "drift over 20 s after settling";
+  EXPECT_LT(s.world.state(0).v_world.norm(), 0.02);
+}
+
 TEST(PhysicsWorld, RotorTorquesTurnTheBodyTheWayTheModelSays) {
   QuadrotorParams q;
   const double h = q.hover_omega();
