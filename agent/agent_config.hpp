@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/agent_rejoin.hpp"
 #include "common/config_fields.hpp"
 #include "common/yaml_section.hpp"
 
@@ -180,7 +181,7 @@ struct AgentConfig {
   double goal_gain = 0.3;
   double teleop_timeout_s = 1.0;
   double server_timeout_s = 1.0;
-  double rejoin_after_s = 40.0;
+  double rejoin_after_s = kDefaultRejoinAfterS;
   double handshake_timeout_s = 10.0;
   double state_loss = 0.0;
 
@@ -226,12 +227,11 @@ struct AgentConfig {
             {"share", in(0, 0.5), "fault injection: the share of swarm-state samples dropped on arrival"});
   }
 
-  /// A join waits rejoin_after_s for the scene, and up to this share longer,
-  /// different in every process: when a whole swarm missed the server, its
-  /// agents must not all re-join at once.
-  static constexpr double kRejoinSpread = 0.5;
+  /// A join waits rejoin_after_s for the scene, and up to this share longer
+  /// (common/agent_rejoin.hpp, which the launcher reads too).
+  static constexpr double kRejoinSpread = ddswarm::kRejoinSpread;
   /// The longest a first join waits for the scene before joining again.
-  double longest_scene_wait_s() const { return rejoin_after_s * (1.0 + kRejoinSpread); }
+  double longest_scene_wait_s() const { return ddswarm::longest_scene_wait_s(rejoin_after_s); }
   void validate() const;  ///< throws FieldError("agent.…")
 };
 

@@ -15,7 +15,7 @@
 
 #include "common/participant.hpp"
 #include "common/process.hpp"
-#include "ground_station/experiment.hpp"
+#include "experiment/experiment.hpp"
 
 namespace ddswarm::gs {
 namespace {

@@ -20,6 +20,7 @@
 namespace ddswarm::gs {
 
 struct SwarmTrace::Impl {
+  std::atomic<bool> stopping{false};  // stop()
   FILE* f;
   FILE* metrics_f = nullptr;
   int every;
@@ -80,11 +81,12 @@ SwarmTrace::SwarmTrace(const DdsConfig& dds, const std::string& path, int every,
 SwarmTrace::~SwarmTrace() = default;
 long SwarmTrace::rows() const { return impl_->rows; }
 long SwarmTrace::metrics_rows() const { return impl_->metrics_rows; }
+void SwarmTrace::stop() { impl_->stopping = true; }
 void SwarmTrace::run(double duration_s) {
   const double end = wall_seconds() + (duration_s > 0 ? duration_s : 1e9);
   LeaseWatch lease(impl_->dds_cfg.lease_duration_s, wall_seconds());
   while (!wait_for_stop(std::chrono::duration<double>(std::min(0.25, end - wall_seconds()))) &&
-         wall_seconds() < end) {
+         !impl_->stopping && wall_seconds() < end) {
     if (const std::string why = lease.turn(wall_seconds()); !why.empty()) {
       spdlog::warn("ddswarm-gs trace: {}", why);
       impl_->join();

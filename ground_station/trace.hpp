@@ -33,7 +33,9 @@ class SwarmTrace {
   ~SwarmTrace();
   long rows() const;
   long metrics_rows() const;  ///< rows written to the metrics file
-  /// Traces until stop_requested() or duration_s (<= 0: until stopped). A
+  /// Ends run() from any thread (within 0.25 s), as SIGINT would.
+  void stop();
+  /// Traces until stop(), stop_requested() or duration_s (<= 0: until stopped). A
   /// process stopped (Ctrl-Z) longer than its DDS lease could stay deaf, so
   /// then it leaves DDS and joins again as a new participant (LeaseWatch);
   /// a tick already written is not written again.

@@ -5,7 +5,7 @@
 # run's agents in two agent-host processes (--agent-hosts 2), it gives the very
 # same results, and it says where the wall time went. Every run's server
 # stops cleanly, and no process outlives the experiment. A swarm launched on
-# the experiment's domain keeps it (ground_station/domain_claim.hpp).
+# the experiment's domain keeps it (common/domain_claim.hpp).
 source "$(dirname "$0")/lib.sh"
 out="$WORK/results"
 out2="$WORK/results2"

@@ -64,6 +64,7 @@ std::string WebBridgeCounts::line() const {
 
 struct WebBridge::Impl {
   WebBridgeOptions opt;
+  std::atomic<bool> stopping{false};  // stop()
 
   // ---- written by DDS callbacks (pointer swaps under a short lock) ----
   struct Latest {
@@ -572,12 +573,13 @@ WebBridge::WebBridge(const WebBridgeOptions& options) : impl_(std::make_unique<I
 WebBridge::~WebBridge() = default;
 
 std::string WebBridge::url() const { return impl_->server->url(); }
+void WebBridge::stop() { impl_->stopping = true; }
 
 WebBridgeCounts WebBridge::run() {
   const double end = impl_->opt.duration_s > 0 ? wall_seconds() + impl_->opt.duration_s : 1e300;
   impl_->server->run([&] {
     if (wall_seconds() >= end) request_stop();  // also ends the commander's waits
-    return stop_requested();
+    return stop_requested() || impl_->stopping;
   });
   auto& n = impl_->n;
   return {n.clients, n.frames_sent, n.frames_replaced, n.malformed, n.rate_limited, n.commands, n.uploads};

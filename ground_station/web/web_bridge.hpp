@@ -47,8 +47,10 @@ class WebBridge {
   WebBridge& operator=(const WebBridge&) = delete;
 
   std::string url() const;
-  /// Serves until stop_requested() or the duration; closes every page cleanly.
+  /// Serves until stop(), stop_requested() or the duration; closes every page cleanly.
   WebBridgeCounts run();
+  /// Ends run() from any thread (within 0.1 s), as SIGINT would.
+  void stop();
 
  private:
   struct Impl;

@@ -1,4 +1,4 @@
-#include "ground_station/launcher.hpp"
+#include "launcher/launcher.hpp"
 
 #include "common/config_error.hpp"
 #include "common/dds_config.hpp"

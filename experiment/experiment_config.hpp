@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "common/scenario_overrides.hpp"  // apply_overrides, parse_set_options
 #include "common/yaml_section.hpp"
 
 namespace ddswarm::gs {
@@ -63,17 +64,6 @@ ExperimentConfig load_experiment_file(const std::string& path);
 
 /// Same, from text; file names the text in errors and anchors the scenario path.
 ExperimentConfig parse_experiment(const std::string& text, const std::string& file);
-
-/// A deep copy of scenario with every override written in: key "a.b.c" sets
-/// scenario[a][b][c], creating missing mappings. Throws ConfigError naming the
-/// key when a path is malformed or walks through a value that is not a mapping.
-YAML::Node apply_overrides(YAML::Node scenario, const std::map<std::string, YAML::Node>& overrides);
-
-/// Command-line overrides, each "key.path=value" (ddswarm-launch --set and
-/// ddswarm-gs experiment --set); the value is YAML. Throws FieldError(option,
-/// text, ...) for text without '=' or with nothing before it.
-std::map<std::string, YAML::Node> parse_set_options(const std::vector<std::string>& texts,
-                                                    const std::string& option = "--set");
 
 /// Writes overrides into every set of c, over the set's own value for the same
 /// key (e.g. `experiment --set sim.physics_rate_hz=250` flies every set at

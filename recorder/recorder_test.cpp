@@ -2,7 +2,7 @@
 // reader (docs/dds.md), never below the pace the recording ran at live.
 #include <gtest/gtest.h>
 
-#include "ground_station/recorder.hpp"
+#include "recorder/recorder.hpp"
 
 namespace ddswarm::gs {
 namespace {

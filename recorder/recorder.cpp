@@ -1,4 +1,4 @@
-#include "ground_station/recorder.hpp"
+#include "recorder/recorder.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -24,7 +24,7 @@
 #include "common/participant.hpp"
 #include "common/process.hpp"
 #include "ddswarm_idl_text.hpp"
-#include "ground_station/sequence_gaps.hpp"
+#include "recorder/sequence_gaps.hpp"
 
 namespace ddswarm::gs {
 
@@ -71,6 +71,7 @@ struct Recorder::Impl {
   std::uint64_t duplicates = 0;  // under mu: samples received again after a re-join, kept once
   std::mutex mu;
   std::condition_variable cv;
+  std::atomic<bool> stopping{false};  // stop()
   std::deque<Item> queue;
   std::size_t max_queue = 0;
   std::map<std::uint16_t, std::string> channel_topic;
@@ -180,7 +181,7 @@ struct Recorder::Impl {
     const double end = duration_s > 0 ? wall_seconds() + duration_s : 1e300;
     try {
       LeaseWatch lease(dds_cfg.lease_duration_s, wall_seconds());
-      while (!stop_requested() && wall_seconds() < end) {
+      while (!stop_requested() && !stopping && wall_seconds() < end) {
         // This loop turns at least every 100 ms plus one drain: a longer gap
         // than the lease means a stop (Ctrl-Z, SIGSTOP) or a starved machine,
         // after which a recorder could stay deaf for the rest of its run.
@@ -198,7 +199,7 @@ struct Recorder::Impl {
         }
         {
           std::unique_lock<std::mutex> lock(mu);
-          cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty(); });
+          cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty() || stopping; });
         }
         drain();
       }
@@ -240,6 +241,10 @@ Recorder::Recorder(const DdsConfig& dds, RecorderOptions options)
     : impl_(std::make_unique<Impl>(dds, std::move(options))) {}
 Recorder::~Recorder() = default;
 RecorderCounts Recorder::run(double duration_s) { return impl_->run(duration_s); }
+void Recorder::stop() {
+  impl_->stopping = true;
+  impl_->cv.notify_all();
+}
 
 std::string describe_recording(const std::string& path, bool messages) {
   mcap::Reader r(path);
@@ -271,8 +276,22 @@ double replay_rate(double asked, double peak_per_s) {
   return std::max(1.0, kReplayMaxSamplesPerS / peak_per_s);
 }
 
-std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double rate, bool loop,
+std::uint64_t replay(const DdsConfig& dds, const std::string& path, double rate, bool loop,
                      const std::vector<std::string>& topics) {
+  return Replay(dds, path, rate, loop, topics).run();
+}
+
+Replay::Replay(DdsConfig dds, std::string path, double rate, bool loop, std::vector<std::string> topics)
+    : dds_(std::move(dds)), path_(std::move(path)), rate_(rate), loop_(loop), topics_(std::move(topics)) {}
+
+bool Replay::stopping() const { return stop_ || stop_requested(); }
+
+std::uint64_t Replay::run() {
+  const DdsConfig& dds_cfg = dds_;
+  const std::string& path = path_;
+  double rate = rate_;
+  const bool loop = loop_;
+  const std::vector<std::string>& topics = topics_;
   if (!(rate > 0)) throw std::invalid_argument("--rate must be > 0");
   mcap::Reader r(path);
   Participant dds(dds_cfg, "ddswarm-replay");
@@ -337,7 +356,7 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
     std::uint64_t first = 0;
     bool have_first = false;
     r.for_each_message([&](const mcap::MessageView& m) {
-      if (stop_requested()) return;
+      if (stopping()) return;
       auto it = publish.find(m.channel_id);
       if (it == publish.end()) return;
       if (!have_first) {
@@ -350,7 +369,7 @@ std::uint64_t replay(const DdsConfig& dds_cfg, const std::string& path, double r
       it->second(m.data);
       ++sent;
     });
-  } while (loop && !stop_requested());
+  } while (loop && !stopping());
   wait_for_stop(std::chrono::milliseconds(500));  // let reliable samples go out
   return sent;
 }

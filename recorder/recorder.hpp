@@ -2,6 +2,7 @@
 // Records the swarm's DDS traffic to MCAP (ROS 2 / Foxglove's log format):
 // one channel per topic, the IDL as an omgidl schema, CDR payloads with
 // receive (log) and source (publish) times, compressed chunks and a summary.
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -42,10 +43,12 @@ class Recorder {
   /// written) and subscribes. Unknown topic names throw std::invalid_argument.
   Recorder(const DdsConfig& dds, RecorderOptions options);
   ~Recorder();
-  /// Records until stop_requested() or duration_s (<= 0: forever); then writes
-  /// every received sample, the summary and the footer. Throws on a write error
-  /// (disk full): the message names the file.
+  /// Records until stop(), stop_requested() or duration_s (<= 0: forever);
+  /// then writes every received sample, the summary and the footer. Throws on
+  /// a write error (disk full): the message names the file.
   RecorderCounts run(double duration_s);
+  /// Ends run() from any thread, as SIGINT would.
+  void stop();
 
  private:
   struct Impl;
@@ -69,10 +72,30 @@ inline constexpr double kReplayMaxSamplesPerS = 10000;
 /// does not, but never under 1, the pace the recording ran at live.
 double replay_rate(double asked, double peak_per_s);
 
-/// Republishes a recording with its original timing scaled by rate (> 0);
-/// loops when asked, until stop_requested(). Returns messages published.
-/// A rate that replay_rate holds is said on stderr, with the rate it runs at.
-/// Throws, before publishing anything, when a live server's scene is on the domain.
+/// ddswarm-replay: republishes a recording with its original timing scaled
+/// by rate (> 0); loops when asked.
+class Replay {
+ public:
+  Replay(DdsConfig dds, std::string path, double rate, bool loop, std::vector<std::string> topics);
+  /// Publishes until the end (looping: until stop() or stop_requested());
+  /// returns messages published. A rate that replay_rate holds is said on
+  /// stderr, with the rate it runs at. Throws, before publishing anything,
+  /// when a live server's scene is on the domain.
+  std::uint64_t run();
+  /// Ends run() from any thread, as SIGINT would.
+  void stop() { stop_ = true; }
+
+ private:
+  bool stopping() const;
+  DdsConfig dds_;
+  std::string path_;
+  double rate_;
+  bool loop_;
+  std::vector<std::string> topics_;
+  std::atomic<bool> stop_{false};
+};
+
+/// Replay(...).run().
 std::uint64_t replay(const DdsConfig& dds, const std::string& path, double rate, bool loop,
                      const std::vector<std::string>& topics);
 

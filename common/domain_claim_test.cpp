@@ -1,7 +1,7 @@
 // Two experiments on one host must not share a DDS domain: each claims its
 // domains, and passes over any that another process claimed or that live
 // participants use.
-#include "ground_station/domain_claim.hpp"
+#include "common/domain_claim.hpp"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "ground_station/experiment_config.hpp"
+#include "experiment/experiment_config.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

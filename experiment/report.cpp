@@ -1,4 +1,4 @@
-#include "ground_station/report.hpp"
+#include "experiment/report.hpp"
 
 #include <fcntl.h>
 #include <signal.h>

@@ -1,41 +1,16 @@
-#include "ground_station/experiment_config.hpp"
+#include "experiment/experiment_config.hpp"
 
 #include <filesystem>
 #include <set>
 #include <stdexcept>
 
 #include "common/config_error.hpp"
+#include "common/scenario_overrides.hpp"
 
 namespace ddswarm::gs {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// Splits "a.b.c" into its parts; returns an empty vector when a part is empty.
-std::vector<std::string> split_key(const std::string& key) {
-  std::vector<std::string> parts;
-  std::string::size_type start = 0;
-  for (;;) {
-    const auto dot = key.find('.', start);
-    parts.push_back(key.substr(start, dot - start));
-    if (parts.back().empty()) return {};
-    if (dot == std::string::npos) return parts;
-    start = dot + 1;
-  }
-}
-
-const char* kind(const YAML::Node& n) {
-  switch (n.Type()) {
-    case YAML::NodeType::Scalar:
-      return "a value";
-    case YAML::NodeType::Sequence:
-      return "a list";
-    case YAML::NodeType::Map:
-      return "a mapping";
-    default:
-      return "empty";
-  }
-}
 
 }  // namespace
 
@@ -56,7 +31,7 @@ void ExperimentConfig::validate() const {
     if (!names.insert(s.name).second)
       throw FieldError(field + ".name", s.name, "another set has this name");
     for (const auto& [key, value] : s.overrides) {
-      if (split_key(key).empty())
+      if (split_key_path(key).empty())
         throw FieldError(field + ".set." + key, key, "must be a dotted key path like agent.x");
       // The map is sorted: keys extending "key." start at lower_bound("key.").
       auto next = s.overrides.lower_bound(key + ".");
@@ -125,52 +100,6 @@ ExperimentConfig parse_experiment(const std::string& text, const std::string& fi
 
 ExperimentConfig load_experiment_file(const std::string& path) {
   return from_document(YamlDocument::load_file(path));
-}
-
-YAML::Node apply_overrides(YAML::Node scenario,
-                           const std::map<std::string, YAML::Node>& overrides) {
-  YAML::Node out = YAML::Clone(scenario);
-  if (!out || out.IsNull()) out = YAML::Node(YAML::NodeType::Map);
-  for (const auto& [key, value] : overrides) {
-    const auto parts = split_key(key);
-    if (parts.empty())
-      throw ConfigError("override " + key + ": must be a dotted key path like agent.x");
-    if (!out.IsMap())
-      throw ConfigError("override " + key + ": the scenario is " + kind(out) + ", not a mapping");
-    // yaml-cpp: Node assignment writes through; reset() rebinds the handle.
-    YAML::Node cur;
-    cur.reset(out);
-    std::string walked;
-    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
-      walked += (i ? "." : "") + parts[i];
-      YAML::Node next = cur[parts[i]];
-      if (!next || next.IsNull()) {
-        cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
-        next.reset(cur[parts[i]]);
-      } else if (!next.IsMap()) {
-        throw ConfigError("override " + key + ": " + walked + " is " + kind(next) +
-                          ", not a mapping");
-      }
-      cur.reset(next);
-    }
-    cur[parts.back()] = YAML::Clone(value);
-  }
-  return out;
-}
-
-std::map<std::string, YAML::Node> parse_set_options(const std::vector<std::string>& texts,
-                                                    const std::string& option) {
-  std::map<std::string, YAML::Node> out;
-  for (const auto& kv : texts) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos || eq == 0) throw FieldError(option, kv, "must be key.path=value");
-    try {
-      out[kv.substr(0, eq)] = YAML::Load(kv.substr(eq + 1));
-    } catch (const YAML::Exception& e) {
-      throw FieldError(option, kv, "value is not YAML: " + e.msg);
-    }
-  }
-  return out;
 }
 
 void override_every_set(ExperimentConfig& c, const std::map<std::string, YAML::Node>& overrides) {

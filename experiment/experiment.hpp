@@ -7,7 +7,7 @@
 
 #include "common/dds_config.hpp"
 #include "ground_station/dds_commander.hpp"
-#include "ground_station/experiment_config.hpp"
+#include "experiment/experiment_config.hpp"
 #include "ground_station/gs_config.hpp"
 
 namespace ddswarm::gs {

@@ -1,4 +1,4 @@
-#include "ground_station/domain_claim.hpp"
+#include "common/domain_claim.hpp"
 
 #include <fcntl.h>
 #include <signal.h>

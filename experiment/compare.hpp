@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "ground_station/report.hpp"
+#include "experiment/report.hpp"
 
 namespace ddswarm::gs {
 

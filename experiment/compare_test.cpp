@@ -1,4 +1,4 @@
-#include "ground_station/compare.hpp"
+#include "experiment/compare.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "ground_station/launcher.hpp"
+#include "launcher/launcher.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>

@@ -1,4 +1,4 @@
-#include "ground_station/sequence_gaps.hpp"
+#include "recorder/sequence_gaps.hpp"
 
 namespace ddswarm::gs {
 

@@ -1,0 +1,382 @@
+#include "launcher/launch.hpp"
+
+#include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "common/agent_rejoin.hpp"
+#include "common/cli_checks.hpp"
+#include "common/config_error.hpp"
+#include "common/participant.hpp"
+#include "common/process.hpp"
+#include "common/scenario.hpp"
+#include "common/scenario_overrides.hpp"
+#include "ground_station/gs_app.hpp"
+
+namespace ddswarm::gs {
+
+namespace {
+
+/// ground_station.discovery_timeout_s in a swarm for which the launcher starts
+/// a discovery server, unless its scenario names one. A ground station that
+/// hears no server through a discovery server joins again after 20 s; at the
+/// default 10 s it would give up first. Restarted after a crash, the
+/// discovery server knows a participant again only when that participant's
+/// lease of the old one lapses (docs/faults.md), and a ground station that
+/// joined meanwhile needs its own re-join.
+constexpr double kDiscoveryServerGsTimeoutS = 60.0;
+
+std::vector<std::string> words(const std::string& s) {
+  std::vector<std::string> w;
+  std::stringstream ss(s);
+  std::string x;
+  while (ss >> x) w.push_back(x);
+  return w;
+}
+
+}  // namespace
+
+void add_launch_command_line(CLI::App& app, LaunchCommandLine& cl) {
+  app.add_option("scenario", cl.scenario, "scenario YAML")->required();
+  app.add_option("--drones", cl.drones, "number of drones (overrides the scenario)");
+  app.add_option("--mode", cl.mode, "lockstep | realtime")->check(CLI::IsMember({"lockstep", "realtime"}));
+  app.add_option("--seed", cl.seed, "scenario seed");
+  app.add_option("--only", cl.only, "start only: server | agents | all")->check(CLI::IsMember({"server", "agents", "all"}));
+  app.add_option("--ids", cl.ids_text, "agents to start, e.g. 3-5,7 (default: all)");
+  app.add_option("--agent-hosts", cl.agent_hosts,
+                 "fly the agents in K agent-host processes (ddswarm-agent --ids) instead of one process per drone")
+      ->check(CLI::Range(1, 1024));
+  app.add_option("--on-death", cl.on_death,
+                 "when a process dies: stop (stop everything, exit 1) | keep (report, keep "
+                 "flying) | restart (start a crashed agent again, up to 3 times each; it "
+                 "rejoins the mission in force; anything else that dies stops everything)")
+      ->check(CLI::IsMember({"stop", "keep", "restart"}));
+  app.add_option(
+      "--gs", cl.gs_script,
+      "ground-station commands to run once every agent is online (waited for up to 30 s plus "
+      "1.5 agent.rejoin_after_s, 90 s by default), e.g. \"takeoff --wait; task\"; "
+      "everything stops when they finish");
+  app.add_flag("--gs-interactive", cl.gs_interactive, "open the ground-station console here");
+  app.add_option("--log-dir", cl.log_dir, "write each process's log to DIR/<name>.log instead of the terminal");
+  app.add_option("--duration", cl.duration_s, "stop everything after this many wall seconds")
+      ->check(finite_range(0.0, 1e9));
+  app.add_option("--record", cl.record_dir, "record the run's DDS traffic to DIR/run-<time>.mcap");
+  app.add_option("--set", cl.sets,
+                 "override a scenario key for this run, e.g. --set comm.latency_s=0.3 (repeatable)");
+  add_dds_options(app, cl.dds_cli);
+  // The launcher's own --discovery-server: it may run the server itself.
+  app.remove_option(app.get_option("--discovery-server"));
+  app.add_option("--discovery-server", cl.ds_text,
+                 fmt::format("Fast DDS discovery server: auto (start one on 127.0.0.1 above {} drones), "
+                             "on (always start one), off, or IP:PORT of a running one",
+                             kAutoDiscoveryServerAbove))
+      ->group("Networking (default: this machine only)");
+}
+
+std::vector<std::string> split_script(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string part;
+  while (std::getline(ss, part, ';')) {
+    auto a = part.find_first_not_of(" \t");
+    if (a == std::string::npos) continue;
+    out.push_back(part.substr(a, part.find_last_not_of(" \t") - a + 1));
+  }
+  return out;
+}
+
+double agents_wait_s(const std::string& scenario) {
+  // A fixed 30 s would give up on an agent cut off at start-up that comes
+  // back at 40-60 s (mp_comm_task).
+  return 30.0 + std::max(longest_scene_wait_s(scenario_rejoin_after_s(scenario)), 0.0);
+}
+
+LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl) : cl_(std::move(cl)) {
+  if (!cl_.sets.empty()) {
+    derive(parse_set_options(cl_.sets), "--set overrides");
+  }
+  if (app.count("--participant-id"))
+    throw FieldError("--participant-id", app.get_option("--participant-id")->as<std::string>(),
+                     "names one process; the launcher starts many (see docs/networking.md, large swarms)");
+  auto file = load_gs_config(cl_.scenario);
+  file_dds_ = file.dds;
+  // A launch that runs a server owns its domain on this host while it runs:
+  // an experiment passes over it, and a second launch says who has it
+  // (common/domain_claim.hpp). Agents alone join a swarm; they claim nothing.
+  dds_ = file.dds;
+  merge_cli(dds_, cl_.dds_cli, app);
+  if (cl_.only != "agents") {
+    claim_.emplace(dds_.domain_id);
+    if (!claim_->held())
+      throw FieldError(app.count("--domain") ? "--domain" : "dds.domain_id", std::to_string(dds_.domain_id),
+                       "claimed on this host by " + claim_->holder() +
+                           "; two swarms on one domain take each other's commands, so choose another");
+  }
+  n_ = cl_.drones.value_or(file.drones);
+  if (n_ < 1 || n_ > 1024) throw FieldError("--drones", std::to_string(n_), "must be in [1, 1024]");
+  if (cl_.only != "server") {
+    if (cl_.ids_text.empty())
+      for (int i = 0; i < n_; ++i) ids_.push_back(i);
+    else
+      try {
+        ids_ = parse_id_ranges(cl_.ids_text, n_);
+      } catch (const std::invalid_argument& e) {
+        throw FieldError("--ids", cl_.ids_text, e.what());
+      }
+  }
+  try {
+    ds_ = parse_discovery_server(cl_.ds_text);
+  } catch (const std::invalid_argument&) {
+    throw FieldError("--discovery-server", cl_.ds_text, "must be auto, on, off or IPv4:port");
+  }
+  if (dds_.secure() && (ds_.kind == DiscoveryServerChoice::Kind::kOn ||
+                        ds_.kind == DiscoveryServerChoice::Kind::kExternal))
+    throw FieldError("--discovery-server", cl_.ds_text,
+                     "cannot be used with --secure: Fast DDS 2.9 has no secure discovery server "
+                     "(docs/security.md)");
+  // Flags every child shares: the domain and the network opt-ins, verbatim.
+  if (ds_.kind == DiscoveryServerChoice::Kind::kExternal) {
+    dds_args_.push_back("--discovery-server");
+    dds_args_.push_back(ds_.address);
+  }
+  for (const char* opt : {"--domain", "--dds-interface", "--dds-local-ip",
+                          "--dds-profiles", "--dds-peers", "--secure"}) {
+    if (app.count(opt)) {
+      auto* o = app.get_option(opt);
+      dds_args_.push_back(opt);
+      std::string v;
+      for (const auto& r : o->results()) v += (v.empty() ? "" : ",") + r;
+      dds_args_.push_back(v);
+    }
+  }
+  // Its value, not just the flag: --best-effort-streams=false must reach the children as false.
+  if (app.count("--best-effort-streams"))
+    dds_args_.push_back(std::string("--best-effort-streams=") + (cl_.dds_cli.best_effort_streams ? "true" : "false"));
+  localhost_discovery_ = file_dds_.discovery == Discovery::kLocalhost && !app.count("--dds-interface") &&
+                         !app.count("--dds-peers");
+  // The whole swarm with its server (not --ids, --only): agent_command's
+  // agents skip their duplicate probe.
+  whole_swarm_ = cl_.only == "all" && cl_.ids_text.empty();
+  bin_ = Launcher::self_dir();
+}
+
+bool LaunchApp::stopping() const { return stop_ || stop_requested(); }
+
+void LaunchApp::derive(const std::map<std::string, YAML::Node>& overrides, const std::string& why) {
+  YAML::Node derived = apply_overrides(YamlDocument::load_file(cl_.scenario).root(), overrides);
+  const std::string dir = cl_.log_dir.empty() ? std::filesystem::temp_directory_path().string() : cl_.log_dir;
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
+  std::ofstream(path) << "# " << cl_.scenario << " with " << why << "\n" << YAML::Dump(derived) << "\n";
+  std::cerr << "ddswarm-launch: scenario with " << why << " written to " << path << "\n";
+  cl_.scenario = path;
+}
+
+int LaunchApp::run() {
+  death_policy_.emplace(parse_on_death(cl_.on_death));
+  procs_.emplace(cl_.gs_interactive && cl_.log_dir.empty() ? "ddswarm-logs" : cl_.log_dir);
+  // What discovery scales with is participants: with agent hosts, a few.
+  const int participants = cl_.agent_hosts > 0 ? std::min<int>(cl_.agent_hosts, n_) + 1 : n_;
+  // Not under DDS Security: Fast DDS 2.9's discovery server has none.
+  if (wants_local_discovery_server(ds_, participants, whole_swarm_, localhost_discovery_ && !dds_.secure()))
+    start_discovery_server();
+  if (!cl_.record_dir.empty()) start_recorder();
+  if (cl_.only != "agents") start_server();
+  warn_about_participant_ids();
+  start_agents();
+  std::cerr << fmt::format("ddswarm-launch: started {} process(es); policy on death: {}\n",
+                           procs_->running(), cl_.on_death);
+  const int rc = supervise();
+  if (death_policy_->stop()) std::cerr << "ddswarm-launch: a process died; stopping everything\n";
+  // A clean shutdown is exit code 0 after our SIGTERM; anything else is worth saying.
+  for (const auto& e : procs_->stop_all(3.0))
+    if ((e.signal != 0 && e.signal != SIGTERM) || (e.signal == 0 && e.exit_code != 0))
+      std::cerr << "ddswarm-launch: at shutdown " << e.describe() << "\n";
+  std::cerr << "ddswarm-launch: all processes stopped\n";
+  if (rc != 0) return 1;
+  return death_policy_->stop() ? 1 : 0;
+}
+
+void LaunchApp::start_discovery_server() {
+  // First, so every participant finds it; clients retry until it answers.
+  const int port = free_udp_port();
+  const ChildSpec ds_spec = discovery_server_spec(port);
+  procs_->start(ds_spec);
+  death_policy_->always_restart(ds_spec);  // on the same port: the address its clients were given
+  procs_->rejoin_dropped_participants("discovery-server");
+  // A longer lease for the swarm's own participants, unless the scenario
+  // names one: under a 128-process bring-up the discovery server, short of
+  // CPU, drops datagrams, and at the default 3 s it lets the server's lease
+  // lapse and loses it for good (docs/performance.md).
+  // And ground stations patient enough for their own re-join through it
+  // (ground_station/subcommands.cpp: after 20 s without a server), which also
+  // carries them over a restart of the discovery server (docs/faults.md).
+  // And no shared-memory transport, unless the scenario names it: a
+  // sender opening a peer's port waits a third of dds.shm_health_check_s
+  // (3.3 s) whenever the port's idle listener was just checked, with
+  // every send of its participant held. In 128-process bring-ups the
+  // server stalls 10-20 s that way and loses up to 119 of 128 agents;
+  // over UDP (the swarm state still by data-sharing) it does not
+  // (docs/dds.md).
+  const YAML::Node root = YamlDocument::load_file(cl_.scenario).root();
+  std::map<std::string, YAML::Node> for_ds;
+  auto unless_named = [&](const char* section, const char* key, const YAML::Node& value) {
+    if (!(root[section] && root[section][key]))
+      for_ds[fmt::format("{}.{}", section, key)] = value;
+  };
+  unless_named("dds", "lease_duration_s", YAML::Node(kDiscoveryServerLeaseS));
+  unless_named("dds", "shm_transport", YAML::Node(false));
+  unless_named("ground_station", "discovery_timeout_s", YAML::Node(kDiscoveryServerGsTimeoutS));
+  if (!for_ds.empty()) {
+    std::string why;
+    for (const auto& [key, value] : for_ds)
+      why += fmt::format("{}{}: {}", why.empty() ? "" : ", ", key, value.as<std::string>());
+    derive(for_ds, why + " (a discovery server)");
+  }
+  const std::string address = "127.0.0.1:" + std::to_string(port);
+  dds_args_.push_back("--discovery-server");
+  dds_args_.push_back(address);
+  std::cerr << "ddswarm-launch: discovery server on " << address
+            << " (other tools join with --discovery-server " << address << ")\n";
+}
+
+void LaunchApp::start_recorder() {
+  // First, so it hears everything; SIGTERM at the end makes it finalize the file.
+  std::filesystem::create_directories(cl_.record_dir);
+  const std::string out = cl_.record_dir + "/run-" + std::to_string(std::time(nullptr)) + ".mcap";
+  std::vector<std::string> a = {bin_ + "/ddswarm-record", "-o", out};
+  a.insert(a.end(), dds_args_.begin(), dds_args_.end());
+  procs_->start({"record", a});
+  std::cerr << "ddswarm-launch: recording to " << out << "\n";
+  wait_for_stop(std::chrono::milliseconds(500));
+}
+
+void LaunchApp::start_server() {
+  std::vector<std::string> a = {bin_ + "/ddswarm-sim", "--scenario", cl_.scenario, "--drones", std::to_string(n_)};
+  if (cl_.mode) {
+    a.push_back("--mode");
+    a.push_back(*cl_.mode);
+  }
+  if (cl_.seed) {
+    a.push_back("--seed");
+    a.push_back(std::to_string(*cl_.seed));
+  }
+  a.insert(a.end(), dds_args_.begin(), dds_args_.end());
+  procs_->start({"sim", a});
+}
+
+void LaunchApp::warn_about_participant_ids() {
+  if (cl_.agent_hosts == 0 && !ids_.empty() && agent_participant_id(n_, ids_.back()) < 0 &&
+      n_ > kExplicitParticipantIdsAbove)
+    std::cerr << fmt::format("ddswarm-launch: warning: {} drones: agents past drone {} get automatic participant "
+                             "ids, and past ~100 participants per host Fast DDS leaves them unreachable "
+                             "(dds.participant_id stops at {}; docs/performance.md)\n",
+                             n_, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
+  if (cl_.agent_hosts == 0 && !ids_.empty() && agent_participant_id(n_, ids_.front()) >= 0) {
+    const std::string w =
+        ephemeral_port_warning(dds_.domain_id, agent_participant_id(n_, ids_.front()),
+                               agent_participant_id(n_, ids_.back()), ephemeral_port_range());
+    if (!w.empty()) std::cerr << "ddswarm-launch: warning: " << w << "\n";
+  }
+}
+
+std::vector<std::string> LaunchApp::agent_args(const std::string& agent_ids, bool host) const {
+  auto a = agent_command(bin_, agent_ids, host, cl_.scenario, whole_swarm_);
+  a.insert(a.end(), {"--drones", std::to_string(n_)});
+  a.insert(a.end(), dds_args_.begin(), dds_args_.end());
+  return a;
+}
+
+void LaunchApp::start_agents() {
+  // Agent hosts: K processes, each flying a contiguous share of the ids.
+  const auto shares = agent_host_shares(ids_, cl_.agent_hosts);
+  const auto start_agent = [&](const ChildSpec& spec) {
+    procs_->start(spec);
+    death_policy_->restartable(spec);  // what --on-death restart may start again
+  };
+  for (std::size_t h = 0; h < shares.size(); ++h)
+    start_agent({"agent host " + std::to_string(h), agent_args(shares[h], true)});
+  for (int id : cl_.agent_hosts > 0 ? std::vector<int>{} : ids_) {
+    auto a = agent_args(std::to_string(id), false);
+    if (const int pid = agent_participant_id(n_, id); pid >= 0) {
+      a.push_back("--participant-id");
+      a.push_back(std::to_string(pid));
+    }
+    start_agent({"agent " + std::to_string(id), a});
+  }
+}
+
+bool LaunchApp::deaths() {
+  for (const auto& e : procs_->reap()) {
+    std::cerr << "ddswarm-launch: " << e.describe() << "\n";
+    if (const auto again = death_policy_->ended(e)) {
+      std::cerr << fmt::format("ddswarm-launch: restarting {} ({} of {})\n", e.name,
+                               death_policy_->restarts(e.name), kMaxRestarts);
+      procs_->start(*again);
+    }
+  }
+  return death_policy_->stop();
+}
+
+std::vector<std::string> LaunchApp::gs_argv(const std::vector<std::string>& sub) const {
+  std::vector<std::string> a = {bin_ + "/ddswarm-gs", "--config", cl_.scenario};
+  a.insert(a.end(), dds_args_.begin(), dds_args_.end());
+  a.insert(a.end(), sub.begin(), sub.end());
+  return a;
+}
+
+int LaunchApp::supervise() {
+  int rc = 0;
+  if (!cl_.gs_script.empty()) {
+    std::vector<std::string> steps = {fmt::format("wait-agents --count {} --timeout {:g}", ids_.size(),
+                                                  agents_wait_s(cl_.scenario))};
+    for (const auto& s : split_script(cl_.gs_script)) steps.push_back(s);
+    for (const auto& step : steps) {
+      if (stopping() || death_policy_->stop()) break;
+      std::cerr << "ddswarm-launch: gs " << step << "\n";
+      rc = run_foreground(gs_argv(words(step)));
+      if (rc != 0) {
+        std::cerr << fmt::format("ddswarm-launch: 'ddswarm-gs {}' failed (exit {})\n", step, rc);
+        break;
+      }
+    }
+  } else if (cl_.gs_interactive) {
+    rc = run_foreground(gs_argv({"menu"}));
+  } else {
+    double end = cl_.duration_s > 0 ? wall_seconds() + cl_.duration_s : 1e300;
+    while (!stopping() && wall_seconds() < end && procs_->running() > 0) {
+      if (deaths()) break;
+      wait_for_stop(std::chrono::milliseconds(100));
+    }
+  }
+  return rc;
+}
+
+int LaunchApp::run_foreground(const std::vector<std::string>& argv) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    unblock_signals_for_exec();
+    std::vector<char*> a;
+    for (const auto& s : argv) a.push_back(const_cast<char*>(s.c_str()));
+    a.push_back(nullptr);
+    execv(a[0], a.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (deaths()) kill(pid, SIGTERM);
+    if (stopping()) kill(pid, SIGINT);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+}  // namespace ddswarm::gs

@@ -1,0 +1,100 @@
+#pragma once
+// ddswarm-launch as an application: its command line (LaunchCommandLine),
+// and LaunchApp, which starts the server and one agent process per drone (and
+// optionally ground-station commands), prefixes their logs and supervises
+// them until they end, --duration passes, a signal or stop().
+#include <CLI/CLI.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/dds_config.hpp"
+#include "common/domain_claim.hpp"
+#include "launcher/launcher.hpp"
+
+namespace ddswarm::gs {
+
+/// Everything ddswarm-launch's command line sets, with the defaults --help shows.
+struct LaunchCommandLine {
+  std::string scenario, only = "all", ids_text, on_death = "stop", gs_script, log_dir;
+  std::optional<int> drones;
+  std::optional<std::string> mode;
+  std::optional<std::uint64_t> seed;
+  double duration_s = 0;
+  bool gs_interactive = false;
+  int agent_hosts = 0;
+  std::string record_dir;
+  std::vector<std::string> sets;
+  DdsConfig dds_cli;
+  std::string ds_text = "auto";  ///< the launcher's own --discovery-server
+};
+
+/// Adds ddswarm-launch's arguments and options to app, bound to cl.
+void add_launch_command_line(CLI::App& app, LaunchCommandLine& cl);
+
+/// Splits a --gs script at ';', trimming blanks and dropping empty steps.
+std::vector<std::string> split_script(const std::string& s);
+
+/// How long --gs waits for the agents before its first step: the bring-up,
+/// plus the longest first join of an agent that heard no scene before it came
+/// back as a new participant (agent.rejoin_after_s, common/agent_rejoin.hpp).
+double agents_wait_s(const std::string& scenario);
+
+class LaunchApp {
+ public:
+  /// Checks the parsed command line, writes the run's scenario when --set
+  /// overrides it, and claims the domain when it runs a server. Starts
+  /// nothing. Throws FieldError/ConfigError naming what is wrong.
+  LaunchApp(const CLI::App& app, LaunchCommandLine cl);
+  LaunchApp(const LaunchApp&) = delete;
+  LaunchApp& operator=(const LaunchApp&) = delete;
+
+  /// Starts every process, runs --gs or the console or waits, then stops
+  /// them all. Returns the exit code: 1 when a process died (policy
+  /// permitting) or a --gs step failed.
+  int run();
+  /// Ends run() from any thread as SIGINT would (the processes are stopped).
+  void stop() { stop_ = true; }
+  /// A stop was asked for: stop() or a signal (stop_requested()).
+  bool stopping() const;
+
+ private:
+  /// Derives the run's scenario with overrides; every process then reads the same file.
+  void derive(const std::map<std::string, YAML::Node>& overrides, const std::string& why);
+  void start_discovery_server();
+  void start_recorder();
+  void start_server();
+  void warn_about_participant_ids();
+  void start_agents();
+  /// Reaps the children that ended, applies --on-death, and says whether to stop.
+  bool deaths();
+  /// --gs, --gs-interactive, or wait for --duration or the end of every process.
+  int supervise();
+  std::vector<std::string> agent_args(const std::string& agent_ids, bool host) const;
+  std::vector<std::string> gs_argv(const std::vector<std::string>& sub) const;
+  /// Runs a child in the foreground with this terminal; returns its exit status.
+  int run_foreground(const std::vector<std::string>& argv);
+
+  LaunchCommandLine cl_;
+  DdsConfig file_dds_;  ///< the scenario's dds section alone
+  DdsConfig dds_;       ///< the swarm's domain and network: the file, then the flags
+  std::optional<DomainClaim> claim_;
+  int n_ = 0;
+  std::vector<int> ids_;
+  DiscoveryServerChoice ds_;
+  std::vector<std::string> dds_args_;  ///< flags every child shares
+  bool localhost_discovery_ = false;
+  bool whole_swarm_ = false;
+  std::string bin_;
+  std::optional<DeathPolicy> death_policy_;
+  std::optional<Launcher> procs_;
+  std::atomic<bool> stop_{false};
+};
+
+}  // namespace ddswarm::gs

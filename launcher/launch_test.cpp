@@ -1,0 +1,83 @@
+#include "launcher/launch.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include "common/config_error.hpp"
+#include "common/process.hpp"
+
+namespace ddswarm::gs {
+namespace {
+
+const std::string kScenario = std::string(DDSWARM_CONFIG_DIR) + "/thesis_course.yaml";
+
+std::filesystem::path temp_dir(const std::string& name) {
+  auto d = std::filesystem::temp_directory_path() /
+           ("gs_launch_test_" + std::to_string(getpid()) + "_" + name);
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+/// A LaunchApp built from ddswarm-launch's command line, args after the program name.
+std::unique_ptr<LaunchApp> build(std::vector<std::string> args) {
+  CLI::App app;
+  LaunchCommandLine cl;
+  add_launch_command_line(app, cl);
+  std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+  app.parse(args);
+  return std::make_unique<LaunchApp>(app, std::move(cl));
+}
+
+TEST(SplitScript, TrimsEachStepAndDropsEmptyOnes) {
+  EXPECT_EQ(split_script("takeoff --wait;  task ; ;\tland "),
+            (std::vector<std::string>{"takeoff --wait", "task", "land"}));
+  EXPECT_TRUE(split_script(" ; ").empty());
+}
+
+TEST(AgentsWait, IsTheBringUpPlusTheLongestFirstJoin) {
+  EXPECT_DOUBLE_EQ(agents_wait_s(kScenario), 90.0);  // agent.rejoin_after_s 40 by default
+  const auto dir = temp_dir("wait");
+  const auto p = (dir / "s.yaml").string();
+  std::ofstream(p) << "scenario:\n  drones: 2\nagent:\n  rejoin_after_s: 10\n";
+  EXPECT_DOUBLE_EQ(agents_wait_s(p), 45.0);
+  std::ofstream(p) << "scenario:\n  drones: 2\nagent:\n  rejoin_after_s: 0\n";
+  EXPECT_DOUBLE_EQ(agents_wait_s(p), 30.0);  // agents that never join again
+  std::filesystem::remove_all(dir);
+}
+
+TEST(LaunchApp, RefusesWhatItCannotStartBeforeStartingAnything) {
+  EXPECT_THROW(build({kScenario, "--participant-id", "3"}), FieldError);
+  EXPECT_THROW(build({kScenario, "--only", "agents", "--drones", "0"}), FieldError);
+  EXPECT_THROW(build({kScenario, "--only", "agents", "--ids", "9"}), FieldError);  // 6 drones
+  EXPECT_THROW(build({kScenario, "--only", "agents", "--discovery-server", "nowhere"}), FieldError);
+}
+
+TEST(LaunchApp, StopEndsTheRunAndStopsItsProcesses) {
+  // One agent, on a domain of its own: it waits for a server that never comes.
+  const auto dir = temp_dir("stop");
+  const int domain = 100 + static_cast<int>(random_instance() % 20);
+  auto launch = build({kScenario, "--only", "agents", "--ids", "0", "--domain", std::to_string(domain),
+                       "--log-dir", dir.string()});
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    launch->stop();
+  });
+  const double t0 = wall_seconds();
+  const int rc = launch->run();
+  const double took = wall_seconds() - t0;
+  stopper.join();
+  EXPECT_EQ(rc, 0);  // stopped, nothing died
+  EXPECT_TRUE(launch->stopping());
+  EXPECT_LT(took, 10.0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "agent_0.log")) << "the agent's log";
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace ddswarm::gs
