@@ -19,6 +19,15 @@ void TaskReferee::start(std::uint32_t seq, double t, double epsilon_m, double sp
   r_.metrics = metrics_.summary();
 }
 
+void TaskReferee::on_mission(MissionType type, std::uint32_t seq, double speed_mps, double epsilon_m,
+                             double d_int_m, double sim_time_s, int drones) {
+  if (running() && (type == MissionType::kLand || type == MissionType::kTask ||
+                    type == MissionType::kMove || type == MissionType::kFollowLeader))
+    fail(std::string("aborted by ") + to_string(type) + " command");
+  if (type == MissionType::kTask)
+    start(seq, sim_time_s, epsilon_m > 0 ? epsilon_m : default_epsilon(d_int_m), speed_mps, drones);
+}
+
 void TaskReferee::fail(const std::string& reason) {
   if (r_.phase != TaskPhase::kRunning) return;
   r_.phase = TaskPhase::kFailed;

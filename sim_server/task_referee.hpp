@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/mission.hpp"
 #include "common/scene.hpp"
 #include "common/swarm_metrics.hpp"
 
@@ -43,6 +44,29 @@ struct TaskReport {
   int components = 0;
 };
 
+/// The drones that count for the task at one tick, gathered drone by drone
+/// into vectors kept across ticks (cleared, never freed).
+struct CountedDrones {
+  std::vector<Eigen::Vector3d> positions;   ///< m, world ENU
+  std::vector<Eigen::Vector3d> velocities;  ///< m/s, world ENU
+  std::vector<int> ids;                     ///< drone ids, in the same order
+  void reserve(int n) {
+    positions.reserve(n);
+    velocities.reserve(n);
+    ids.reserve(n);
+  }
+  void clear() {
+    positions.clear();
+    velocities.clear();
+    ids.clear();
+  }
+  void add(int id, const Eigen::Vector3d& p_world, const Eigen::Vector3d& v_world) {
+    positions.push_back(p_world);
+    velocities.push_back(v_world);
+    ids.push_back(id);
+  }
+};
+
 class TaskReferee {
  public:
   /// metrics: the communication range, near-miss distance and λ₂ size limit
@@ -51,6 +75,12 @@ class TaskReferee {
       : scene_(scene), metrics_options_(metrics), metrics_(metrics) {}
 
   void start(std::uint32_t seq, double sim_time_s, double epsilon_m, double speed_mps, int drones);
+  /// A mission command released at sim_time_s: a land, task, move or follow
+  /// command aborts a running task; a task command (seq) starts one over the
+  /// drones at speed_mps, within epsilon_m (m; 0: default_epsilon of d_int_m,
+  /// the inter-drone distance in force).
+  void on_mission(MissionType type, std::uint32_t seq, double speed_mps, double epsilon_m, double d_int_m,
+                  double sim_time_s, int drones);
   /// Stops a running task as failed with reason (e.g. "aborted by land").
   void fail(const std::string& reason);
   /// One tick: the drones that count (lost drones excluded by the caller),

@@ -1,0 +1,39 @@
+// ServerConfig: what the server reads from a scenario file, and its checks.
+#include "sim_server/sim_server.hpp"
+
+namespace ddswarm::sim {
+
+void ServerConfig::validate() const {
+  scenario.validate();
+  sim.validate();
+  quadrotor.validate();
+  controller.validate();
+  sensors.validate();
+  scene.validate();
+  // Nothing lies beyond the world's bounds: a longer ray is a typo (cm for m?).
+  const double world_m = (scene.bounds_max - scene.bounds_min).norm();
+  if (sensors.max_range_m > world_m)
+    throw FieldError("sensors.max_range_m", to_text(sensors.max_range_m),
+                     "must be <= the world's size (diagonal of scene.bounds_min..bounds_max, " +
+                         to_text(world_m) + " m)");
+  dds.validate();
+  (void)scene.start_positions(scenario.drones, scenario.seed);
+}
+
+ServerConfig load_server_config(const std::string& path) {
+  auto doc = load_scenario(path);
+  ServerConfig c;
+  doc.guard([&] {
+    load(doc.section("scenario"), c.scenario);
+    load(doc.section("sim"), c.sim);
+    load(doc.section("quadrotor"), c.quadrotor);
+    load(doc.section("controller"), c.controller);
+    load(doc.section("sensors"), c.sensors);
+    load(doc.section("scene"), c.scene);
+    load(doc.section("dds"), c.dds);
+    c.validate();
+  });
+  return c;
+}
+
+}  // namespace ddswarm::sim

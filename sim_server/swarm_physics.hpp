@@ -1,0 +1,42 @@
+#pragma once
+// The swarm's bodies and flight controllers. Each control period, every
+// drone's controller turns its velocity setpoint into rotor commands at the
+// physics rate and the Bullet world steps. Pure: no DDS, no clock (sim time
+// advances only by step), no I/O. Positions ENU in m, world frame.
+#include <array>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "common/scene.hpp"
+#include "sim_server/flight_controller.hpp"
+#include "sim_server/physics_world.hpp"
+#include "sim_server/quadrotor.hpp"
+
+namespace ddswarm::sim {
+
+class SwarmPhysics {
+ public:
+  /// starts: one per drone, m; every drone starts level at yaw scene.start.yaw_rad.
+  /// seed: the scenario's; each drone's sensor noise has its own generator.
+  SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor, const ControllerConfig& controller,
+               const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed);
+
+  /// Steps one control period: substeps physics steps of dt_s s, drone i
+  /// flying setpoints[i]. Returns the contacts that began, in step order.
+  std::vector<ContactEvent> step(const std::vector<VelocitySetpoint>& setpoints, int substeps, double dt_s);
+
+  RigidState state(int drone) const { return world_.state(drone); }
+  /// rad/s, actual (lagged) rotor speeds.
+  std::array<double, 4> rotor_speeds(int drone) const { return world_.rotor_speeds(drone); }
+  /// Casts the drone's distance sensors (PhysicsWorld::cast_rays) with its own generator.
+  void cast_rays(int drone, const SensorConfig& sensors, std::vector<float>& range_m,
+                 std::vector<std::uint8_t>& hit);
+
+ private:
+  PhysicsWorld world_;
+  std::vector<FlightController> controllers_;
+  std::vector<std::mt19937_64> sensor_rng_;
+};
+
+}  // namespace ddswarm::sim
