@@ -373,27 +373,37 @@ void PhysicsWorld::step(double dt) {
   const double c_lin = params_.drag_linear_n_per_mps;
   const double c_ang = params_.angular_drag_nm_per_rad_s;
 
-  for (Drone& d : drones_) {
+  const double prop_r = 0.5 * params_.prop_diameter_m;
+  for (std::size_t n = 0; n < drones_.size(); ++n) {
+    Drone& d = drones_[n];
     double thrust = 0.0;
     Eigen::Vector3d torque_b(0, 0, 0);
+    btRigidBody& body = *d.body;
+    const Eigen::Matrix3d r = to_eigen(body.getWorldTransform().getBasis());
+    const Eigen::Vector3d p = to_eigen(body.getWorldTransform().getOrigin());
     for (int i = 0; i < 4; ++i) {
       d.omega[i] += lag * (d.omega_cmd[i] - d.omega[i]);
       const double w2 = d.omega[i] * d.omega[i];
-      const double t = k_f_ * w2;
+      double t = k_f_ * w2;
+      // Each rotor's hub height above the ground sets its ground effect.
+      if (aero_.ground_effect) t *= ground_effect_ratio((p + r * rotor_pos_[i]).z() - ground_z_m_, prop_r);
       thrust += t;
       torque_b.x() += rotor_pos_[i].y() * t;
       torque_b.y() -= rotor_pos_[i].x() * t;
       torque_b.z() -= QuadrotorParams::rotor_spin(i) * k_m_ * w2;
     }
-    btRigidBody& body = *d.body;
-    const Eigen::Matrix3d r = to_eigen(body.getWorldTransform().getBasis());
     // Drag acts on the airspeed: the velocity relative to the air (the wind).
     const Eigen::Vector3d v_b = r.transpose() * (to_eigen(body.getLinearVelocity()) - d.air_world);
     const Eigen::Vector3d w_b = r.transpose() * to_eigen(body.getAngularVelocity());
     Eigen::Vector3d force_b = -c_quad.cwiseProduct(v_b.cwiseProduct(v_b.cwiseAbs())) - c_lin * v_b;
     force_b.z() += thrust;
     torque_b -= c_ang * w_b;
-    body.applyCentralForce(to_bt(r * force_b));
+    Eigen::Vector3d force_w = r * force_b;
+    if (aero_.downwash)
+      for (std::size_t m = 0; m < drones_.size(); ++m)
+        if (m != n)
+          force_w.z() -= downwash_force(aero_, to_eigen(drones_[m].body->getWorldTransform().getOrigin()), p, prop_r);
+    body.applyCentralForce(to_bt(force_w));
     body.applyTorque(to_bt(r * torque_b));
   }
   world_->stepSimulation(static_cast<btScalar>(dt), 0);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/scene.hpp"
+#include "sim_server/aero.hpp"
 #include "sim_server/quadrotor.hpp"
 
 class btDefaultCollisionConfiguration;
@@ -82,6 +83,8 @@ class PhysicsWorld {
   /// body drag acts on the velocity relative to it. Held until changed; calm
   /// (zero) at start.
   void set_air_velocity(int drone, const Eigen::Vector3d& air_world) { drones_[drone].air_world = air_world; }
+  /// Ground effect and downwash (sim/aero.hpp); off unless set.
+  void set_aero(const AeroConfig& aero) { aero_ = aero; }
 
   /// Advances one fixed step of dt seconds: motor lag, rotor thrust k_f w^2 at
   /// the rotor hubs along body z, reaction torques -+k_m w^2 about body z,
@@ -175,6 +178,7 @@ class PhysicsWorld {
 
   QuadrotorParams params_;
   double ground_z_m_;
+  AeroConfig aero_;
   // Rotor model, cached from params_.
   double k_f_, k_m_, omega_min_, omega_max_;
   std::array<Eigen::Vector3d, 4> rotor_pos_;

@@ -153,6 +153,48 @@ TEST(PhysicsWorld, AHoveringDroneHoldsItsPlaceInASteadyWind) {
   EXPECT_LT(s.world.state(0).v_world.norm(), 0.02);
 }
 
+TEST(PhysicsWorld, GroundEffectLiftsAHoverNearTheGroundAsCheesemanAndBennettSay) {
+  // Hub one rotor radius above the ground: thrust 16/15 of the hover's, so
+  // the drone accelerates up at g / 15.
+  QuadrotorParams q;
+  const double r = 0.5 * q.prop_diameter_m;
+  PhysicsWorld w(empty_scene(), q, {{0, 0, 0}}, 0.0);
+  AeroConfig a;
+  a.ground_effect = true;
+  w.set_aero(a);
+  w.reset_drone(0, {0, 0, 20}, 0.0);  // spin up far from the ground first
+  const double h = q.hover_omega();
+  w.set_rotor_commands(0, {h, h, h, h});
+  step_for(w, 0.1);
+  w.reset_drone(0, {0, 0, r - q.collision_half_height_m}, 0.0);  // the body centre (the rotor plane) at z = R
+  w.set_rotor_commands(0, {h, h, h, h});
+  step_for(w, 0.05);  // the motors spin up again (5 ms lag)
+  const double v0 = w.state(0).v_world.z();
+  step_for(w, 0.01);
+  EXPECT_NEAR((w.state(0).v_world.z() - v0) / 0.01, kGravityMps2 / 15, 0.1 * kGravityMps2 / 15);
+}
+
+TEST(PhysicsWorld, DownwashPushesADroneHalfAMetreBelowAnotherAsTheModelSays) {
+  QuadrotorParams q;
+  PhysicsWorld w(empty_scene(), q, {{0, 0, 0}, {3, 0, 0}}, 0.0);
+  AeroConfig a;
+  a.downwash = true;
+  w.set_aero(a);
+  w.reset_drone(0, {0, 0, 20.5}, 0.0);
+  w.reset_drone(1, {0, 0, 20.0}, 0.0);
+  const double h = q.hover_omega();
+  for (int i : {0, 1}) w.set_rotor_commands(i, {h, h, h, h});
+  step_for(w, 0.02);
+  const double v_top = w.state(0).v_world.z(), v_low = w.state(1).v_world.z();
+  step_for(w, 0.005);
+  const double force = downwash_force(a, w.state(0).p_world, w.state(1).p_world, 0.5 * q.prop_diameter_m);
+  EXPECT_GT(force, 1.0);
+  // Against the drone above, which feels nothing (both still spin up alike).
+  const double a_top = (w.state(0).v_world.z() - v_top) / 0.005;
+  const double a_low = (w.state(1).v_world.z() - v_low) / 0.005;
+  EXPECT_NEAR((a_low - a_top) * q.mass_kg, -force, 0.05 * force);
+}
+
 TEST(PhysicsWorld, RotorTorquesTurnTheBodyTheWayTheModelSays) {
   QuadrotorParams q;
   const double h = q.hover_omega();

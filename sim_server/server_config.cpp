@@ -1,6 +1,8 @@
 // ServerConfig: what the server reads from a scenario file, and its checks.
 #include "sim_server/sim_server.hpp"
 
+#include "common/world_gen.hpp"
+
 namespace ddswarm::sim {
 
 void ServerConfig::validate() const {
@@ -10,6 +12,7 @@ void ServerConfig::validate() const {
   controller.validate();
   sensors.validate();
   scene.validate();
+  wind.validate();
   // Nothing lies beyond the world's bounds: a longer ray is a typo (cm for m?).
   const double world_m = (scene.bounds_max - scene.bounds_min).norm();
   if (sensors.max_range_m > world_m)
@@ -30,7 +33,14 @@ ServerConfig load_server_config(const std::string& path) {
     load(doc.section("controller"), c.controller);
     load(doc.section("sensors"), c.sensors);
     load(doc.section("scene"), c.scene);
+    load(doc.section("wind"), c.wind);
+    load(doc.section("aero"), c.aero);
     load(doc.section("dds"), c.dds);
+    c.scene.validate();
+    // The server generates the world once, before anything is placed in it;
+    // every other process receives it in the Scene.
+    if (c.scene.generate.enabled())
+      c.generated_world = generate_world(c.scene.generate, c.scenario.seed, c.scene).summary();
     c.validate();
   });
   return c;

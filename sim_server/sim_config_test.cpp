@@ -86,3 +86,22 @@ TEST(ServerConfig, MissingFileIsAClearError) {
     EXPECT_STREQ(e.what(), "/no/such/scenario.yaml: cannot open file");
   }
 }
+
+TEST(ServerConfig, WindAeroAndGeneratedWorldsAreReadChecked) {
+  EXPECT_EQ(error_for("wind:\n  steady_mps: [3, 0, 0]\n  turbulence: true\n  gusts_per_minute: 2\naero:\n"
+                      "  ground_effect: true\n  downwash: true\n"),
+            "");
+  EXPECT_EQ(error_for("wind:\n  turbulence: true\n").rfind("2: wind.turbulence = true: Dryden turbulence", 0), 0u);
+  EXPECT_EQ(error_for("wind:\n  gusts_per_minute: -1\n"), "2: wind.gusts_per_minute = -1: must be in [0, 600]");
+  EXPECT_NE(error_for("aero:\n  ground_efect: true\n").find("ground_efect"), std::string::npos);
+  EXPECT_EQ(error_for("scene:\n  generate:\n    walls:\n      count: 1\n      window_height_m: 9\n"),
+            "5: scene.generate.walls.window_height_m = 9: a window from 1 m up this tall does not fit in a "
+            "wall 6 m high");
+  // The server generates the world once, into the scene it publishes.
+  const std::string path = ::testing::TempDir() + "/forest.yaml";
+  std::ofstream(path) << "scenario:\n  seed: 5\nscene:\n  generate:\n    forest:\n      density_per_100m2: 1\n";
+  const ServerConfig c = load_server_config(path);
+  EXPECT_EQ(c.scene.cylinders.size(), 36u) << "1 per 100 m² over the default 80 m x 45 m";
+  EXPECT_NE(c.generated_world.find("a forest of 36 pillars (of 36 wanted)"), std::string::npos) << c.generated_world;
+  EXPECT_EQ(load_server_config(path).scene.cylinders[7].center_xy, c.scene.cylinders[7].center_xy) << "seeded";
+}

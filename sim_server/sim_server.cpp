@@ -83,7 +83,7 @@ struct SimServer::Impl {
         pipelined(cfg.sim.lockstep_pipeline && cfg.scenario.mode == TimeMode::kLockstep),
         rt_pipelined(cfg.sim.realtime_pipeline && cfg.scenario.mode == TimeMode::kRealtime),
         starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
-        swarm(cfg.scene, cfg.quadrotor, cfg.controller, starts, cfg.scenario.seed),
+        swarm(cfg.scene, cfg.quadrotor, cfg.controller, starts, cfg.scenario.seed, cfg.wind, cfg.aero),
         referee(cfg.scene, cfg.sim.metrics()),
         dds(cfg.dds, kServerParticipantName),
         out(dds, cfg.sim),
@@ -376,6 +376,14 @@ struct SimServer::Impl {
         cfg.scenario.name, n, to_string(cfg.scenario.mode),
         pipelined || rt_pipelined ? " (pipelined: commands act one tick later)" : "",
         cfg.sim.physics_rate_hz, cfg.sim.control_rate_hz, cfg.scenario.seed);
+    if (!cfg.generated_world.empty()) spdlog::info("ddswarm-sim: generated world: {}", cfg.generated_world);
+    if (cfg.wind.enabled())
+      spdlog::info("ddswarm-sim: wind {:.1f} m/s{}{}", cfg.wind.steady_mps.norm(),
+                   cfg.wind.turbulence ? ", Dryden turbulence" : "",
+                   cfg.wind.gusts_per_minute > 0 ? ", gusts" : "");
+    if (cfg.aero.enabled())
+      spdlog::info("ddswarm-sim: aerodynamics:{}{}", cfg.aero.ground_effect ? " ground effect" : "",
+                   cfg.aero.downwash ? " downwash" : "");
     if (cfg.scenario.mode == TimeMode::kLockstep)
       run_lockstep(deadline);
     else

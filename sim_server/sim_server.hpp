@@ -7,10 +7,12 @@
 #include "common/dds_config.hpp"
 #include "common/scenario.hpp"
 #include "common/scene.hpp"
+#include "sim_server/aero.hpp"
 #include "sim_server/flight_controller.hpp"
 #include "sim_server/physics_world.hpp"
 #include "sim_server/quadrotor.hpp"
 #include "sim_server/sim_config.hpp"
+#include "sim_server/wind.hpp"
 
 namespace ddswarm::sim {
 
@@ -22,7 +24,11 @@ struct ServerConfig {
   ControllerConfig controller;
   SensorConfig sensors;
   SceneConfig scene;
+  WindConfig wind;
+  AeroConfig aero;
   DdsConfig dds;
+  /// What scene.generate added (load_server_config generates it), for the log.
+  std::string generated_world;
   void validate() const;
 };
 

@@ -4,8 +4,9 @@ namespace ddswarm::sim {
 
 SwarmPhysics::SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor,
                            const ControllerConfig& controller, const std::vector<Eigen::Vector3d>& starts,
-                           std::uint64_t seed)
-    : world_(scene, quadrotor, starts, scene.start.yaw_rad) {
+                           std::uint64_t seed, const WindConfig& wind, const AeroConfig& aero)
+    : world_(scene, quadrotor, starts, scene.start.yaw_rad), wind_(wind, seed) {
+  world_.set_aero(aero);
   const int n = static_cast<int>(starts.size());
   for (int i = 0; i < n; ++i) {
     controllers_.emplace_back(quadrotor, controller);
@@ -18,6 +19,11 @@ SwarmPhysics::SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quad
 std::vector<ContactEvent> SwarmPhysics::step(const std::vector<VelocitySetpoint>& setpoints, int substeps,
                                              double dt_s) {
   const int n = static_cast<int>(controllers_.size());
+  if (wind_.enabled()) {
+    const double t = world_.time_s();
+    wind_.advance_to(t);
+    for (int i = 0; i < n; ++i) world_.set_air_velocity(i, wind_.at(world_.state(i).p_world, t));
+  }
   for (int k = 0; k < substeps; ++k) {
     for (int i = 0; i < n; ++i) {
       auto omega = controllers_[i].update(world_.state(i), setpoints[i], dt_s);

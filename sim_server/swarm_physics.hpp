@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "common/scene.hpp"
+#include "sim_server/aero.hpp"
 #include "sim_server/flight_controller.hpp"
 #include "sim_server/physics_world.hpp"
 #include "sim_server/quadrotor.hpp"
+#include "sim_server/wind.hpp"
 
 namespace ddswarm::sim {
 
@@ -19,11 +21,15 @@ class SwarmPhysics {
  public:
   /// starts: one per drone, m; every drone starts level at yaw scene.start.yaw_rad.
   /// seed: the scenario's; each drone's sensor noise has its own generator.
+  /// wind and aero: calm and off unless asked (sim/wind.hpp, sim/aero.hpp).
   SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor, const ControllerConfig& controller,
-               const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed);
+               const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed, const WindConfig& wind = {},
+               const AeroConfig& aero = {});
 
   /// Steps one control period: substeps physics steps of dt_s s, drone i
-  /// flying setpoints[i]. Returns the contacts that began, in step order.
+  /// flying setpoints[i]. The wind at each drone is taken once a period, at
+  /// its start (its turbulence changes over seconds, a period is 20 ms).
+  /// Returns the contacts that began, in step order.
   std::vector<ContactEvent> step(const std::vector<VelocitySetpoint>& setpoints, int substeps, double dt_s);
 
   RigidState state(int drone) const { return world_.state(drone); }
@@ -35,6 +41,7 @@ class SwarmPhysics {
 
  private:
   PhysicsWorld world_;
+  WindField wind_;
   std::vector<FlightController> controllers_;
   std::vector<std::mt19937_64> sensor_rng_;
 };
