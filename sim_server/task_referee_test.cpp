@@ -131,3 +131,31 @@ TEST(TaskReferee, GathersTheSwarmMetricsOfEveryTickOfTheTask) {
   EXPECT_EQ(r.report().metrics.near_misses, 0u);
   EXPECT_EQ(r.report().metrics.components_max, 0);
 }
+
+TEST(TaskReferee, AMissionCommandStartsOrAbortsTheTask) {
+  SceneConfig s = course();
+  TaskReferee r(s);
+  // A task command without epsilon: 2 D_int + 1 of the distance in force.
+  r.on_mission(MissionType::kTask, 7, 0.8, 0.0, 3.0, 12.0, 6);
+  ASSERT_TRUE(r.running());
+  EXPECT_EQ(r.report().seq, 7u);
+  EXPECT_DOUBLE_EQ(r.report().epsilon_m, default_epsilon(3.0));
+  EXPECT_DOUBLE_EQ(r.report().start_sim_time_s, 12.0);
+  EXPECT_DOUBLE_EQ(r.report().speed_mps, 0.8);
+  EXPECT_EQ(r.report().drones, 6);
+  // Takeoff, hold or a new distance leave it running.
+  r.on_mission(MissionType::kHold, 8, 0.0, 0.0, 3.0, 13.0, 6);
+  r.on_mission(MissionType::kSetDistance, 9, 5.0, 0.0, 3.0, 13.0, 6);
+  EXPECT_TRUE(r.running());
+  r.on_mission(MissionType::kLand, 10, 0.0, 0.0, 3.0, 14.0, 6);
+  EXPECT_EQ(r.report().phase, TaskPhase::kFailed);
+  EXPECT_EQ(r.report().reason, std::string("aborted by ") + to_string(MissionType::kLand) + " command");
+  // Another task command starts a new task (epsilon given) ...
+  r.on_mission(MissionType::kTask, 11, 1.0, 9.5, 3.0, 15.0, 6);
+  EXPECT_TRUE(r.running());
+  EXPECT_DOUBLE_EQ(r.report().epsilon_m, 9.5);
+  // ... and a task command while one runs aborts it, then starts the new one.
+  r.on_mission(MissionType::kTask, 12, 1.0, 9.5, 3.0, 16.0, 6);
+  EXPECT_TRUE(r.running());
+  EXPECT_EQ(r.report().seq, 12u);
+}
