@@ -30,9 +30,10 @@ void check_overrides(const AgentAppConfig& c) {
   for (std::size_t k = 0; k < c.agent.overrides.size(); ++k)
     for (int id : c.agent.overrides[k].ids)
       if (id >= c.scenario.drones)
-        throw FieldError("agent.overrides[" + std::to_string(k) + "].ids", c.agent.overrides[k].ids_text,
-                         "drone " + std::to_string(id) + " is not in the scenario (scenario.drones = " +
-                             std::to_string(c.scenario.drones) + ")");
+        throw FieldError(
+            "agent.overrides[" + std::to_string(k) + "].ids", c.agent.overrides[k].ids_text,
+            "drone " + std::to_string(id) + " is not in the scenario (scenario.drones = " +
+                std::to_string(c.scenario.drones) + ")");
 }
 }  // namespace
 
@@ -73,8 +74,7 @@ namespace {
 /// A broken or hostile Scene sample is refused before anything of it is applied.
 std::string scene_problem(const msg::Scene& s) {
   try {
-    check_range("scene.control_rate_hz", s.control_rate_hz(), kMinControlRateHz,
-                kMaxControlRateHz);
+    check_range("scene.control_rate_hz", s.control_rate_hz(), kMinControlRateHz, kMaxControlRateHz);
     from_msg(s).validate();
   } catch (const std::exception& e) {
     return e.what();
@@ -133,9 +133,15 @@ msg::VelocityCommand command_msg(const DroneCommand& c) {
 
 void log_note(const BrainNote& n) {
   switch (n.level) {
-    case BrainNote::Level::kInfo: spdlog::info("{}", n.text); break;
-    case BrainNote::Level::kWarn: spdlog::warn("{}", n.text); break;
-    case BrainNote::Level::kError: spdlog::error("{}", n.text); break;
+    case BrainNote::Level::kInfo:
+      spdlog::info("{}", n.text);
+      break;
+    case BrainNote::Level::kWarn:
+      spdlog::warn("{}", n.text);
+      break;
+    case BrainNote::Level::kError:
+      spdlog::error("{}", n.text);
+      break;
   }
 }
 
@@ -169,11 +175,11 @@ struct AgentApp::Impl {
   // A lost server that is gone (lost_server_gone): the swarm-state reader is
   // made anew (sync_states_reader), once per loss, as docs/faults.md says.
   bool renew_states = false;
-  bool states_renewed = false;  // for this loss
-  std::uint64_t rejected = 0;  // samples refused before any drone saw them
-  std::mt19937_64 loss_rng;    // agent.state_loss: which samples to drop
-  bool loss_logged = false;    // agent.state_loss said so in the log
-  bool copy_logged = false;    // a copied scene was refused, and the log said so
+  bool states_renewed = false;    // for this loss
+  std::uint64_t rejected = 0;     // samples refused before any drone saw them
+  std::mt19937_64 loss_rng;       // agent.state_loss: which samples to drop
+  bool loss_logged = false;       // agent.state_loss said so in the log
+  bool copy_logged = false;       // a copied scene was refused, and the log said so
   bool bad_scene_logged = false;  // a scene that cannot be flown was refused, and the log said so
   // This tick's sample, converted once for every brain in the process.
   SwarmTick swarm;
@@ -231,10 +237,11 @@ struct AgentApp::Impl {
                 "drone {} is already flown on this host: a process holds its participant id {} "
                 "(UDP 127.0.0.1:{}); if it is no agent, give this one --participant-id",
                 c.drone_ids[0], id, port));
-          spdlog::warn("drone {}: participant id {}'s port {} is held, and lies in the kernel's "
-                       "ephemeral port range, where any socket may hold it; Fast DDS picks an id "
-                       "instead (docs/security.md)",
-                       c.drone_ids[0], id, port);
+          spdlog::warn(
+              "drone {}: participant id {}'s port {} is held, and lies in the kernel's "
+              "ephemeral port range, where any socket may hold it; Fast DDS picks an id "
+              "instead (docs/security.md)",
+              c.drone_ids[0], id, port);
           d.participant_id = -1;
         }
       }
@@ -281,8 +288,9 @@ struct AgentApp::Impl {
       std::lock_guard<std::mutex> lock(mu);
       for (const auto& b : brains)
         if (b->rival)
-          throw DuplicateAgent("drone " + std::to_string(b->brain.id()) + " is already flown by agent " +
-                               fmt::format("{:016x}", b->rival) + " (" + b->rival_where + ")");
+          throw DuplicateAgent("drone " + std::to_string(b->brain.id()) +
+                               " is already flown by agent " + fmt::format("{:016x}", b->rival) +
+                               " (" + b->rival_where + ")");
     }
     // Every agent hearing every other's heartbeat is O(N^2) traffic: at 64
     // agents it cost 1.7 cores of a paused swarm. After the probe, a rival is
@@ -349,13 +357,15 @@ struct AgentApp::Impl {
                      s.server_instance(), why);
       return;
     }
-    const int highest = cfg.drone_ids.empty() ? 0 : *std::max_element(cfg.drone_ids.begin(), cfg.drone_ids.end());
+    const int highest =
+        cfg.drone_ids.empty() ? 0 : *std::max_element(cfg.drone_ids.begin(), cfg.drone_ids.end());
     if (s.num_drones() <= highest) {
       spdlog::error("{}: the server flies only {} drones", label, s.num_drones());
       return;
     }
     server = from;
-    if (scene && s.server_instance() == server_instance) return;  // a re-announcement: keep the mission
+    if (scene && s.server_instance() == server_instance)
+      return;  // a re-announcement: keep the mission
     scene_wall = wall_seconds();
     if (scene) {
       // A restarted server is a new world: the drone is back at its start,
@@ -389,10 +399,11 @@ struct AgentApp::Impl {
       spdlog::info("{}: scene '{}' received", label, s.name().to_string());
     const double reach = sensor_range_m(cfg.agent.sensor_function);
     if (reach > s.sensor_max_range_m() + 1e-6)
-      spdlog::warn("{}: agent.sensor_function reacts up to {:.1f} m but the sensors "
-                   "(sensors.max_range_m) see only {:.1f} m: the reaction jumps when an obstacle "
-                   "comes into view",
-                   label, reach, s.sensor_max_range_m());
+      spdlog::warn(
+          "{}: agent.sensor_function reacts up to {:.1f} m but the sensors "
+          "(sensors.max_range_m) see only {:.1f} m: the reaction jumps when an obstacle "
+          "comes into view",
+          label, reach, s.sensor_max_range_m());
   }
 
   void start_brain(Drone& d) {
@@ -404,9 +415,10 @@ struct AgentApp::Impl {
     const double ticks_per_beacon = scene_control_rate_hz / cfg.comm.beacon_rate_hz;
     if (cfg.comm.source == PeerSourceType::kBeacons &&
         std::abs(ticks_per_beacon - std::round(ticks_per_beacon)) > 1e-9)
-      spdlog::warn("{}: comm.beacon_rate_hz {} does not divide the control rate {} Hz; "
-                   "beacons go every {} ticks",
-                   label, cfg.comm.beacon_rate_hz, scene_control_rate_hz, std::round(ticks_per_beacon));
+      spdlog::warn(
+          "{}: comm.beacon_rate_hz {} does not divide the control rate {} Hz; "
+          "beacons go every {} ticks",
+          label, cfg.comm.beacon_rate_hz, scene_control_rate_hz, std::round(ticks_per_beacon));
     spdlog::info("{}: peers from {} through the communication model", label,
                  cfg.comm.source == PeerSourceType::kBeacons ? "beacons" : "truth");
   }
@@ -428,7 +440,8 @@ struct AgentApp::Impl {
         s.server_lost(server_lost);
         s.last_tick(last_tick);
         s.inter_distance_m(b.inter_distance_m());
-        s.rejected_samples(static_cast<std::uint32_t>(rejected + b.rejected() + malformed_samples().load()));
+        s.rejected_samples(
+            static_cast<std::uint32_t>(rejected + b.rejected() + malformed_samples().load()));
         s.commands_sent(static_cast<std::uint32_t>(b.sent()));
         s.law(b.law_config().name().substr(0, 32));
         s.law_faults(static_cast<std::uint32_t>(b.law_faults()));
@@ -451,7 +464,8 @@ struct AgentApp::Impl {
                      100 * cfg.agent.state_loss);
       return;
     }
-    if (from != server || !std::isfinite(s.sim_time_s())) {  // not the server that announced the scene
+    if (from != server ||
+        !std::isfinite(s.sim_time_s())) {  // not the server that announced the scene
       ++rejected;
       return;
     }
@@ -557,8 +571,9 @@ struct AgentApp::Impl {
     const double joined = wall_seconds();
     // Both waits spread by process, up to AgentConfig::kRejoinSpread longer,
     // so that agents that missed the server do not all join again at once.
-    const double spread =
-        1.0 + AgentConfig::kRejoinSpread * static_cast<double>(brains[0]->brain.instance() % 1024) / 1024.0;
+    const double spread = 1.0 + AgentConfig::kRejoinSpread *
+                                    static_cast<double>(brains[0]->brain.instance() % 1024) /
+                                    1024.0;
     JoinPatience join_patience;
     join_patience.lease_s = cfg.dds.lease_duration_s;
     join_patience.scene_wait_s = cfg.agent.rejoin_after_s * spread;
@@ -585,10 +600,11 @@ struct AgentApp::Impl {
         return AgentApp::End::kOutlivedLease;
       }
       if (take_rejoin_request()) {
-        spdlog::warn("{}: asked to join again (SIGUSR1, as ddswarm-launch sends when its discovery "
-                     "server dropped this participant); leaving DDS and joining again as a new "
-                     "participant",
-                     label);
+        spdlog::warn(
+            "{}: asked to join again (SIGUSR1, as ddswarm-launch sends when its discovery "
+            "server dropped this participant); leaving DDS and joining again as a new "
+            "participant",
+            label);
         return AgentApp::End::kRejoinRequested;
       }
       sync_states_reader();
@@ -613,7 +629,8 @@ struct AgentApp::Impl {
         view.scene_writer_matched = scenes->matched() > 0;
         view.scene_matched_since_s = scenes->matched_since();
         for (const auto& b : brains)  // < 0: heard, or the server went silent since
-          if (b->unheard_since >= 0) view.unheard_since.emplace_back(b->brain.id(), b->unheard_since);
+          if (b->unheard_since >= 0)
+            view.unheard_since.emplace_back(b->brain.id(), b->unheard_since);
         for (const auto& p : dds.peers_named(kServerParticipantName))
           view.servers.push_back({p.prefix == server, p.announced_s, p.authenticated_after_s});
         view.secure = dds.secure();
@@ -629,7 +646,8 @@ struct AgentApp::Impl {
         // stop is requested (stop_waker), else after 250 ms: no polling, so
         // this thread wakes 4 times a second, not 20.
         woke.wait_for(lock, std::chrono::milliseconds(250), [&] {
-          return stop_requested() || (states_wanted && (!states || *states_wanted != states_delivery));
+          return stop_requested() ||
+                 (states_wanted && (!states || *states_wanted != states_delivery));
         });
       }
     }

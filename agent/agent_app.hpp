@@ -25,7 +25,7 @@ struct AgentAppConfig {
   /// The drones this process flies, each in [0, scenario.drones): one (the
   /// usual agent process) or many (an agent host, `--ids 0-511`).
   std::vector<int> drone_ids{0};
-  double duplicate_probe_s = 1.0;///< s wall: listen for another agent on this id before flying
+  double duplicate_probe_s = 1.0;  ///< s wall: listen for another agent on this id before flying
   void validate() const;
 };
 

@@ -102,12 +102,18 @@ void SensorFunctionConfig::validate() const {
 
 const char* to_string(LawType t) {
   switch (t) {
-    case LawType::kThesis: return "thesis";
-    case LawType::kReynolds: return "reynolds";
-    case LawType::kOlfatiSaber: return "olfati_saber";
-    case LawType::kVasarhelyi: return "vasarhelyi";
-    case LawType::kPlugin: return "plugin";
-    case LawType::kPython: return "python";
+    case LawType::kThesis:
+      return "thesis";
+    case LawType::kReynolds:
+      return "reynolds";
+    case LawType::kOlfatiSaber:
+      return "olfati_saber";
+    case LawType::kVasarhelyi:
+      return "vasarhelyi";
+    case LawType::kPlugin:
+      return "plugin";
+    case LawType::kPython:
+      return "python";
   }
   return "?";
 }
@@ -131,8 +137,12 @@ void LawConfig::validate() const {
   } catch (const law::ParamError& e) {
     throw FieldError(e.field(), e.value(), e.reason());
   } catch (const std::exception& e) {
-    throw FieldError(path + (type == LawType::kPlugin ? ".library" : type == LawType::kPython ? ".class" : ".type"),
-                     type == LawType::kPlugin ? library : type == LawType::kPython ? class_name : to_string(type),
+    throw FieldError(path + (type == LawType::kPlugin   ? ".library"
+                             : type == LawType::kPython ? ".class"
+                                                        : ".type"),
+                     type == LawType::kPlugin   ? library
+                     : type == LawType::kPython ? class_name
+                                                : to_string(type),
                      std::string("the law could not be built: ") + e.what());
   }
 }
@@ -205,7 +215,8 @@ void load(YamlSection s, LawConfig& c) {
     for (auto it = p.node().begin(); it != p.node().end(); ++it) {
       const std::string key = it->first.Scalar();
       if (!it->second.IsScalar())
-        p.fail(it->second, key, "(not a scalar)", "a law parameter must be a number, true/false or a word");
+        p.fail(it->second, key, "(not a scalar)",
+               "a law parameter must be a number, true/false or a word");
       std::string value;
       p.get(key, value);
       c.params[key] = value;

@@ -46,7 +46,8 @@ struct ActivationConfig {
     // where D_r > 0; held flat beyond the ends.
     v.field("points", c.points, {"m, m/s", any(), "custom: [[D_r, f], ...]"});
     v.field("cutoff_m", c.cutoff_m,
-            {"m", non_negative(), "peers farther than this are ignored; 0 = none, else > inter_distance_m"});
+            {"m", non_negative(),
+             "peers farther than this are ignored; 0 = none, else > inter_distance_m"});
     // The thesis's Eq. 3.2 is 0. [0, kMaxNeighbours].
     v.field("neighbours", c.neighbours,
             {"", any(), "only the k nearest peers (within cutoff_m) act; 0 = every peer"});
@@ -76,19 +77,23 @@ struct SensorFunctionConfig {
                                                     {"custom", SensorFunctionType::kCustom}};
     v.choice("type", c.type, kTypes, {"", any(), "the shape of f_s"});
     v.field("max_mps", c.max_mps, {"m/s", positive(), "fs1/fs2 plateau; log clamp"});
-    v.field("log_gain_mps", c.log_gain_mps, {"m/s", positive(), "k in the log function k*ln(S_max/S)"});
+    v.field("log_gain_mps", c.log_gain_mps,
+            {"m/s", positive(), "k in the log function k*ln(S_max/S)"});
     // S >= 0 strictly increasing, f >= 0, last f = 0 (its S is the function's
     // range); below the first S the first f holds.
     v.field("points", c.points, {"m, m/s", any(), "custom: [[S, f], ...]"});
     // The other terms lose their component toward the obstacle and the
     // repulsion is raised to agent.max_speed_mps.
-    v.field("safety_distance_m", c.safety_distance_m,
-            {"m", non_negative(), "a hit closer than this makes obstacle repulsion dominate; 0 = off"});
+    v.field(
+        "safety_distance_m", c.safety_distance_m,
+        {"m", non_negative(), "a hit closer than this makes obstacle repulsion dominate; 0 = off"});
     // ddswarm's addition to Eq. 3.3 (0 = the thesis's pure law): a drone dead
     // behind a pillar goes round it instead of stalling in a local minimum of
     // the potential field.
-    v.field("slide_gain", c.slide_gain,
-            {"", in(0, 2), "the blocked part of the command is redirected along the obstacle's surface, times this"});
+    v.field(
+        "slide_gain", c.slide_gain,
+        {"", in(0, 2),
+         "the blocked part of the command is redirected along the obstacle's surface, times this"});
   }
 
   void validate() const;  ///< throws FieldError("agent.sensor_function.…")
@@ -132,14 +137,17 @@ struct LawConfig {
                                          {"python", LawType::kPython}};
     static const Choices<Obstacles> kObstacles{
         {"auto", Obstacles::kAuto}, {"law", Obstacles::kLaw}, {"framework", Obstacles::kFramework}};
-    static const Choices<Fault> kFaults{{"none", Fault::kNone}, {"nan", Fault::kNaN}, {"throw", Fault::kThrow}};
+    static const Choices<Fault> kFaults{
+        {"none", Fault::kNone}, {"nan", Fault::kNaN}, {"throw", Fault::kThrow}};
     v.choice("type", c.type, kTypes, {"", any(), "the law"});
     v.field("library", c.library, {"", any(), "plugin: the law's shared library"});
     v.field("module", c.module, {"", any(), "python: the law's .py file"});
     v.field("class", c.class_name, {"", any(), "python: the law's class"});
     v.choice("obstacles", c.obstacles, kObstacles, {"", any(), "who avoids obstacles"});
-    v.choice("fault", c.fault, kFaults, {"", any(), "fault injection: the law throws or answers NaN"});
-    v.field("fault_after_s", c.fault_after_s, {"s (sim)", in(0, 3600), "when the injected fault begins"});
+    v.choice("fault", c.fault, kFaults,
+             {"", any(), "fault injection: the law throws or answers NaN"});
+    v.field("fault_after_s", c.fault_after_s,
+            {"s (sim)", in(0, 3600), "when the injected fault begins"});
   }
 
   void validate() const;  ///< builds the law once: throws FieldError("agent.law.params.…")
@@ -190,41 +198,51 @@ struct AgentConfig {
   /// validate() adds the checks that relate fields.
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    v.field("inter_distance_m", c.inter_distance_m, {"m", positive(), "D_int, wanted drone-to-drone distance"});
+    v.field("inter_distance_m", c.inter_distance_m,
+            {"m", positive(), "D_int, wanted drone-to-drone distance"});
     v.field("max_speed_mps", c.max_speed_mps,
             {"m/s", positive(), "limit on the commanded speed (horizontal, then total)"});
     v.field("altitude_hold", c.altitude_hold,
             {"", any(), "hold the cruise altitude (replaces vertical R&A) while airborne"});
-    v.field("altitude_gain", c.altitude_gain, {"1/s", positive(), "vertical P gain toward the altitude target"});
+    v.field("altitude_gain", c.altitude_gain,
+            {"1/s", positive(), "vertical P gain toward the altitude target"});
     v.field("altitude_tolerance_m", c.altitude_tolerance_m,
             {"m", positive(), "takeoff is done within this of its altitude"});
-    v.field("min_altitude_m", c.min_altitude_m, {"m", positive(), "lowest cruise altitude above ground"});
-    v.field("takeoff_altitude_m", c.takeoff_altitude_m,
-            {"m", positive(), "default takeoff and cruise altitude above ground; >= min_altitude_m"});
+    v.field("min_altitude_m", c.min_altitude_m,
+            {"m", positive(), "lowest cruise altitude above ground"});
+    v.field(
+        "takeoff_altitude_m", c.takeoff_altitude_m,
+        {"m", positive(), "default takeoff and cruise altitude above ground; >= min_altitude_m"});
     v.field("takeoff_speed_mps", c.takeoff_speed_mps,
             {"m/s", positive(), "climb-rate limit of the altitude loop; <= max_speed_mps"});
     v.field("landing_speed_mps", c.landing_speed_mps,
-            {"m/s", positive(), "landing descent rate, sink limit of the altitude loop; <= max_speed_mps"});
+            {"m/s", positive(),
+             "landing descent rate, sink limit of the altitude loop; <= max_speed_mps"});
     v.field("task_speed_mps", c.task_speed_mps,
             {"m/s", positive(), "task speed when a task command carries 0; <= max_speed_mps"});
     v.field("goal_gain", c.goal_gain, {"1/s", in(1e-6, 5), "past the finish: pull toward goal_xy"});
-    v.field("teleop_timeout_s", c.teleop_timeout_s,
-            {"s (sim)", positive(), "follow mode: the leader's teleop velocity drops to 0 after this"});
+    v.field(
+        "teleop_timeout_s", c.teleop_timeout_s,
+        {"s (sim)", positive(), "follow mode: the leader's teleop velocity drops to 0 after this"});
     v.field("server_timeout_s", c.server_timeout_s,
-            {"s (wall)", positive(), "no server sample this long: server lost (logged, flagged in heartbeats)"});
+            {"s (wall)", positive(),
+             "no server sample this long: server lost (logged, flagged in heartbeats)"});
     // Up to kRejoinSpread longer, spread by process.
     v.field("rejoin_after_s", c.rejoin_after_s,
-            {"s (wall)", zero_or(2, 3600), "no scene this long after joining: join again as a new participant; 0 = never"});
+            {"s (wall)", zero_or(2, 3600),
+             "no scene this long after joining: join again as a new participant; 0 = never"});
     // Fast DDS 2.9 sometimes leaves a handshake pending for good. Up to
     // kRejoinSpread longer, spread by process; twice as long after each such
     // join in a row, at most 8 times.
     v.field("handshake_timeout_s", c.handshake_timeout_s,
             {"s (wall)", zero_or(2, 3600),
-             "DDS Security: the server's handshake with this agent has not ended this long after it announced "
+             "DDS Security: the server's handshake with this agent has not ended this long after "
+             "it announced "
              "itself: join again; 0 = never"});
     // Real time flies on the next sample; lockstep waits sim.lockstep_resend_s for the tick again.
     v.field("state_loss", c.state_loss,
-            {"share", in(0, 0.5), "fault injection: the share of swarm-state samples dropped on arrival"});
+            {"share", in(0, 0.5),
+             "fault injection: the share of swarm-state samples dropped on arrival"});
   }
 
   /// A join waits rejoin_after_s for the scene, and up to this share longer

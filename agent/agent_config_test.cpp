@@ -226,13 +226,17 @@ agent:
 TEST(AgentConfig, ALawRefusesWhatItDoesNotTakeNamingFileLineAndField) {
   const std::string unknown =
       error_of("agent:\n  law:\n    type: reynolds\n    params:\n      cohesion_gian: 1\n");
-  EXPECT_EQ(unknown.rfind("s.yaml:5: agent.law.params.cohesion_gian = 1: unknown parameter (this law takes ", 0), 0u)
+  EXPECT_EQ(
+      unknown.rfind(
+          "s.yaml:5: agent.law.params.cohesion_gian = 1: unknown parameter (this law takes ", 0),
+      0u)
       << unknown;
   EXPECT_NE(unknown.find("cohesion_gain"), std::string::npos) << unknown;
   EXPECT_EQ(error_of("agent:\n  law: {type: thesis, params: {gain: 2}}\n"),
             "s.yaml:2: agent.law.params.gain = 2: unknown parameter (this law takes none)");
   EXPECT_EQ(error_of("agent:\n  law: {type: boids}\n"),
-            "s.yaml:2: agent.law.type = boids: must be one of olfati_saber|plugin|python|reynolds|thesis|vasarhelyi");
+            "s.yaml:2: agent.law.type = boids: must be one of "
+            "olfati_saber|plugin|python|reynolds|thesis|vasarhelyi");
   EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, params: {cohesion_gain: fast}}\n"),
             "s.yaml:2: agent.law.params.cohesion_gain = fast: must be a finite number");
   EXPECT_EQ(error_of("agent:\n  law: {type: reynolds, params: {cohesion_gain: [1, 2]}}\n")
@@ -259,7 +263,8 @@ TEST(AgentConfig, AnOverrideIsCheckedLikeTheSwarmsLaw) {
 TEST(AgentConfig, AnInjectedLawFaultNeedsAKind) {
   EXPECT_EQ(error_of("agent:\n  law: {fault_after_s: 3}\n"),
             "s.yaml:2: agent.law.fault_after_s = 3: needs fault: nan or throw");
-  EXPECT_EQ(loaded("agent:\n  law: {fault: throw, fault_after_s: 3}\n").law.fault, LawConfig::Fault::kThrow);
+  EXPECT_EQ(loaded("agent:\n  law: {fault: throw, fault_after_s: 3}\n").law.fault,
+            LawConfig::Fault::kThrow);
 }
 
 TEST(AgentConfig, APluginLibraryThatCannotBeFlownIsRefusedWithItsReason) {
@@ -284,9 +289,11 @@ TEST(AgentConfig, TheReferenceDescribesEveryFieldAsTheCodeDeclaresIt) {
   const std::string doc = configuration_reference();
   using Mismatches = std::vector<std::string>;
   EXPECT_EQ(reference_mismatches(doc, "### `agent:`", field_rows<AgentConfig>()), Mismatches{});
-  EXPECT_EQ(reference_mismatches(doc, "(`agent.activation`)", field_rows<ActivationConfig>()), Mismatches{});
-  EXPECT_EQ(reference_mismatches(doc, "(`agent.sensor_function`)", field_rows<SensorFunctionConfig>()),
+  EXPECT_EQ(reference_mismatches(doc, "(`agent.activation`)", field_rows<ActivationConfig>()),
             Mismatches{});
+  EXPECT_EQ(
+      reference_mismatches(doc, "(`agent.sensor_function`)", field_rows<SensorFunctionConfig>()),
+      Mismatches{});
   EXPECT_EQ(reference_mismatches(doc, "(`agent.law`)", field_rows<LawConfig>()), Mismatches{});
   EXPECT_EQ(reference_mismatches(doc, "### `comm:`", field_rows<CommConfig>()), Mismatches{});
 }

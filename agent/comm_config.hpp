@@ -39,28 +39,40 @@ struct CommConfig {
   static void fields(Self& c, V& v) {
     static const Choices<PeerSourceType> kSources{{"truth", PeerSourceType::kTruth},
                                                   {"beacons", PeerSourceType::kBeacons}};
-    v.choice("source", c.source, kSources,
-             {"", any(), "truth: the server's exact positions every tick; beacons: each agent's own estimate"});
+    v.choice(
+        "source", c.source, kSources,
+        {"", any(),
+         "truth: the server's exact positions every tick; beacons: each agent's own estimate"});
     // The application checks that the rate divides the control rate (it knows it).
-    v.field("beacon_rate_hz", c.beacon_rate_hz, {"Hz", up_to(1000), "how often a drone sends its beacon"});
+    v.field("beacon_rate_hz", c.beacon_rate_hz,
+            {"Hz", up_to(1000), "how often a drone sends its beacon"});
     // Bounded so a delay in ticks can never overflow; a minute is already absurd for a swarm.
-    v.field("latency_s", c.latency_s, {"s", in(0, 60), "fixed delay of every message (rounded to ticks)"});
-    v.field("jitter_s", c.jitter_s, {"s", in(0, 60), "each message waits latency_s + U[0, jitter_s]"});
+    v.field("latency_s", c.latency_s,
+            {"s", in(0, 60), "fixed delay of every message (rounded to ticks)"});
+    v.field("jitter_s", c.jitter_s,
+            {"s", in(0, 60), "each message waits latency_s + U[0, jitter_s]"});
     v.field("loss_probability", c.loss_probability,
             {"", in(0, 1), "chance a message never reaches a given receiver"});
     v.field("position_noise_sigma_m", c.position_noise_sigma_m,
-            {"m", non_negative(), "Gaussian noise per axis on a received position, per receiver and message"});
-    v.field("max_range_m", c.max_range_m,
-            {"m", non_negative(), "a peer farther than this (true distance when it sends) is never heard; 0 = unlimited"});
+            {"m", non_negative(),
+             "Gaussian noise per axis on a received position, per receiver and message"});
+    v.field(
+        "max_range_m", c.max_range_m,
+        {"m", non_negative(),
+         "a peer farther than this (true distance when it sends) is never heard; 0 = unlimited"});
     v.field("range_measurements", c.range_measurements,
             {"", any(), "UWB-like: a noisy distance comes with each heard message"});
     v.field("range_noise_sigma_m", c.range_noise_sigma_m,
             {"m", non_negative(), "Gaussian noise on a measured distance"});
     v.field("own_position_noise_sigma_m", c.own_position_noise_sigma_m,
-            {"m", non_negative(), "GPS-like noise on the drone's own position, as its law sees it and its beacons report it"});
+            {"m", non_negative(),
+             "GPS-like noise on the drone's own position, as its law sees it and its beacons "
+             "report it"});
     v.field("peer_timeout_s", c.peer_timeout_s,
-            {"s (sim)", positive(), "a peer not heard for longer drops out of the repulsion-attraction sum"});
-    v.field("seed_salt", c.seed_salt, {"", any(), "mixed with scenario.seed: same scenario, other draws"});
+            {"s (sim)", positive(),
+             "a peer not heard for longer drops out of the repulsion-attraction sum"});
+    v.field("seed_salt", c.seed_salt,
+            {"", any(), "mixed with scenario.seed: same scenario, other draws"});
   }
 
   /// True when the model changes nothing: truth, no delay, loss, noise or

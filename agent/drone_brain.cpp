@@ -84,10 +84,11 @@ void DroneBrain::fault(const std::string& why, double t, TickAnswer& a) {
   if (!law_fault_.empty()) return;
   law_fault_ = one_line(why);
   law_fault_at_s_ = t;
-  a.notes.push_back(note(BrainNote::Level::kError,
-                         fmt::format("drone {}: the {} law faulted at sim time {:.2f} s: {}; the "
-                                     "drone hovers {:.0f} s, then lands, and takes no mission command",
-                                     id_, law_cfg_->name(), t, law_fault_, kLawFaultHoverS)));
+  a.notes.push_back(
+      note(BrainNote::Level::kError,
+           fmt::format("drone {}: the {} law faulted at sim time {:.2f} s: {}; the "
+                       "drone hovers {:.0f} s, then lands, and takes no mission command",
+                       id_, law_cfg_->name(), t, law_fault_, kLawFaultHoverS)));
 }
 
 /// A faulted law's drone: hovers where it is, then lands through its mission
@@ -144,14 +145,15 @@ void DroneBrain::handle_missions(const SwarmTick& t, const Observation& obs, Tic
     }
     if (!fsm_->addressed_to_me(c)) continue;
     if (!law_fault_.empty()) {
-      a.acks.push_back({{id16, c.seq, false, "swarm law faulted: " + law_fault_, fsm_->phase(), t.tick},
-                        m.issuer_instance});
+      a.acks.push_back(
+          {{id16, c.seq, false, "swarm law faulted: " + law_fault_, fsm_->phase(), t.tick},
+           m.issuer_instance});
       continue;
     }
     const bool caught_up = joining && m.apply_tick < t.tick;
-    MissionAck ack = caught_up
-                         ? fsm_->resume(c, static_cast<double>(m.apply_tick) * control_period_s_, obs)
-                         : fsm_->apply(c, obs);
+    MissionAck ack =
+        caught_up ? fsm_->resume(c, static_cast<double>(m.apply_tick) * control_period_s_, obs)
+                  : fsm_->apply(c, obs);
     if (ack.accepted) {  // relayed by the server (SimStatus.mission_seq, mission_issuer)
       last_mission_seq_ = c.seq;
       last_mission_issuer_ = m.issuer_instance;
@@ -159,10 +161,11 @@ void DroneBrain::handle_missions(const SwarmTick& t, const Observation& obs, Tic
     const std::string why = ack.accepted ? "" : ": " + ack.reason;
     a.notes.push_back(note(
         BrainNote::Level::kInfo,
-        caught_up ? fmt::format("drone {}: joined mid-mission: caught up with {} seq {} of tick {}{}",
-                                id_, to_string(c.type), c.seq, m.apply_tick, why)
-                  : fmt::format("drone {}: {} seq {} {} at tick {}{}", id_, to_string(c.type), c.seq,
-                                ack.accepted ? "accepted" : "rejected", t.tick, why)));
+        caught_up
+            ? fmt::format("drone {}: joined mid-mission: caught up with {} seq {} of tick {}{}",
+                          id_, to_string(c.type), c.seq, m.apply_tick, why)
+            : fmt::format("drone {}: {} seq {} {} at tick {}{}", id_, to_string(c.type), c.seq,
+                          ack.accepted ? "accepted" : "rejected", t.tick, why)));
     a.acks.push_back({std::move(ack), m.issuer_instance});
   }
 }
@@ -181,7 +184,8 @@ void DroneBrain::feed_peers(const SwarmTick& t, const DroneRow& me, bool new_tic
     modelled_->set_tick(t.tick, t.sim_time_s, me.p_world);
     modelled_->on_truth(t.sim_time_s, t.roster);  // skips its own id
     for (const auto& bc : t.beacons) {
-      if (bc.sender == id_ || bc.sender < 0 || static_cast<std::size_t>(bc.sender) >= t.drones.size())
+      if (bc.sender == id_ || bc.sender < 0 ||
+          static_cast<std::size_t>(bc.sender) >= t.drones.size())
         continue;
       modelled_->on_beacon(bc, me.p_world);
     }
@@ -292,7 +296,8 @@ TickAnswer DroneBrain::tick(const SwarmTick& t) {
     for (const auto& h : modelled_->heard(t.sim_time_s)) {
       const Eigen::Vector3d d = h.p_world - own_p;
       const auto r = modelled_->range_to(h.id);
-      ranged_.push_back(r && d.norm() > 1e-6 ? Eigen::Vector3d(own_p + d.normalized() * *r) : h.p_world);
+      ranged_.push_back(r && d.norm() > 1e-6 ? Eigen::Vector3d(own_p + d.normalized() * *r)
+                                             : h.p_world);
     }
     in.peers_world = ranged_;
   } else {

@@ -64,7 +64,8 @@ struct SwarmTick {
 
   /// Drone id's row, or nullptr when the sample has none for it.
   const DroneRow* row(int id) const {
-    if (id < 0 || static_cast<std::size_t>(id) >= drones.size() || drones[id].id != id) return nullptr;
+    if (id < 0 || static_cast<std::size_t>(id) >= drones.size() || drones[id].id != id)
+      return nullptr;
     return &drones[id];
   }
 };
@@ -79,8 +80,8 @@ struct DroneCommand {
   bool motors_on = false;
   Phase phase = Phase::kIdle;
   bool busy = false;
-  std::uint32_t mission_seq = 0;      ///< the last mission command accepted
-  std::uint64_t mission_issuer = 0;   ///< and its issuer instance
+  std::uint32_t mission_seq = 0;     ///< the last mission command accepted
+  std::uint64_t mission_issuer = 0;  ///< and its issuer instance
   std::uint64_t agent_instance = 0;
   /// The drone's beacon this tick (comm.source beacons, when one is due).
   std::optional<PeerMessage> beacon;
@@ -128,7 +129,8 @@ class DroneBrain {
   /// A scene starts the mission: the mission machine, the law (built from
   /// law_seed(seed, id)), the peer source. Returns what the log should say
   /// (a law that cannot be built faults the drone at once).
-  std::vector<BrainNote> start(const SceneConfig& scene, double control_rate_hz, std::uint64_t seed);
+  std::vector<BrainNote> start(const SceneConfig& scene, double control_rate_hz,
+                               std::uint64_t seed);
   /// A new server: the mission, the law and what was heard are forgotten
   /// until start() (law faults are kept).
   void reset();
@@ -193,8 +195,8 @@ class DroneBrain {
   std::unique_ptr<law::SwarmLaw> law_;
   std::vector<law::Peer> law_peers_;
   std::vector<law::Ray> law_rays_;
-  double yaw_rate_rad_s_ = 0;   // the law's, this tick
-  std::string law_fault_;       // the first fault; empty while the law is sound
+  double yaw_rate_rad_s_ = 0;  // the law's, this tick
+  std::string law_fault_;      // the first fault; empty while the law is sound
   std::uint64_t law_faults_ = 0;
   double law_fault_at_s_ = -1;  // sim time of the fault
   bool fault_landing_ = false;  // the fault's hover ended and the landing was ordered

@@ -266,10 +266,12 @@ TEST(DroneBrain, AFaultedLawHoversThenLandsAndRefusesMissions) {
   s.run(3.9);
   ASSERT_TRUE(s.brains[0]->law_fault().empty());
   bool noted = false;
-  for (int k = 0; k < 20; ++k) noted |= says(s.step()[0], "drone 0: the thesis law faulted at sim time 4.00 s");
+  for (int k = 0; k < 20; ++k)
+    noted |= says(s.step()[0], "drone 0: the thesis law faulted at sim time 4.00 s");
   EXPECT_TRUE(noted);
   EXPECT_EQ(s.brains[0]->phase(), Phase::kFailsafe);
-  EXPECT_NE(s.brains[0]->law_fault().find("non-finite"), std::string::npos) << s.brains[0]->law_fault();
+  EXPECT_NE(s.brains[0]->law_fault().find("non-finite"), std::string::npos)
+      << s.brains[0]->law_fault();
   // Hovers: no horizontal motion, commands finite and marked failsafe.
   TickAnswer a = s.step()[0];
   EXPECT_EQ(a.command.phase, Phase::kFailsafe);

@@ -325,7 +325,8 @@ MissionOutput MissionFsm::step(const Observation& o) {
         // The leader is the pilot's drone (the thesis's RC drone): it flies the
         // teleop velocity, not pulled back by its followers; obstacles still count.
         out.swarm_enabled = false;
-        if (o.sim_time_s - teleop_time_s_ <= cfg_.teleop_timeout_s) out.mission_velocity = teleop_velocity_;
+        if (o.sim_time_s - teleop_time_s_ <= cfg_.teleop_timeout_s)
+          out.mission_velocity = teleop_velocity_;
       }
       out.busy = true;
       break;

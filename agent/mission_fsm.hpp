@@ -59,8 +59,8 @@ struct MissionOutput {
   double altitude_target_m = 0;               ///< m, world z for the altitude loop
   bool altitude_hold = false;                 ///< run the altitude loop (takeoff: always)
   bool busy = false;                          ///< the lockstep clock is needed (see step())
-  bool swarm_horizontal_only = false;         ///< landing: the swarm term keeps drones apart sideways only
-  double inter_distance_m = 4.0;              ///< m, D_int in force
+  bool swarm_horizontal_only = false;  ///< landing: the swarm term keeps drones apart sideways only
+  double inter_distance_m = 4.0;       ///< m, D_int in force
 };
 
 class MissionFsm {

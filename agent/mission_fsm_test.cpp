@@ -204,7 +204,8 @@ TEST(MissionFsm, TaskFliesTowardTheGoalThenSwarmsPastTheFinish) {
   EXPECT_GT(f.out.mission_velocity.y(), 0.0);
   EXPECT_LE(f.out.mission_velocity.norm(), 0.8 + 1e-12);
   EXPECT_FALSE(f.out.busy) << "gathering: the server's task referee keeps the clock running";
-  ASSERT_TRUE(f.run_until([&] { return (f.o.p_world.head<2>() - Eigen::Vector2d(0, 15)).norm() < 0.5; }, 60))
+  ASSERT_TRUE(f.run_until(
+      [&] { return (f.o.p_world.head<2>() - Eigen::Vector2d(0, 15)).norm() < 0.5; }, 60))
       << "reaches the goal";
   EXPECT_LT(f.out.mission_velocity.norm(), 0.2) << "and slows to a stop there";
 

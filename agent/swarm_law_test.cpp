@@ -193,9 +193,9 @@ TEST(RepulsionAttraction, NeighboursMatchTheFullSortBitForBit) {
 namespace {
 
 struct Packing {
-  double closest = 1e9;        ///< m, closest pair
-  double widest_gap = 0;       ///< m, the farthest any drone is from its nearest peer
-  bool connected = false;      ///< every drone within 1.5 D_int of the rest, transitively
+  double closest = 1e9;    ///< m, closest pair
+  double widest_gap = 0;   ///< m, the farthest any drone is from its nearest peer
+  bool connected = false;  ///< every drone within 1.5 D_int of the rest, transitively
 };
 
 /// One kinematic step of every drone on the law alone: x += v dt.
@@ -237,7 +237,8 @@ Packing settle(int n, double spacing, const AgentConfig& c, double t_s) {
     k.widest_gap = std::max(k.widest_gap, nearest);
   }
   k.connected = true;
-  for (std::size_t i = 0; i < p.size(); ++i) k.connected = k.connected && root(static_cast<int>(i)) == root(0);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    k.connected = k.connected && root(static_cast<int>(i)) == root(0);
   return k;
 }
 
@@ -253,9 +254,10 @@ TEST(DenseSwarm, EveryPeerPacksThirtyTwoDronesTightKNearestKeepsThemApart) {
   AgentConfig topo;
   topo.activation.neighbours = 6;
   const Packing k6 = settle(32, 2.0, topo, 60);
-  std::printf("32 drones after 60 s: every peer: closest pair %.2f m; 6 nearest: closest %.2f m, "
-              "widest nearest-neighbour gap %.2f m\n",
-              sum.closest, k6.closest, k6.widest_gap);
+  std::printf(
+      "32 drones after 60 s: every peer: closest pair %.2f m; 6 nearest: closest %.2f m, "
+      "widest nearest-neighbour gap %.2f m\n",
+      sum.closest, k6.closest, k6.widest_gap);
   EXPECT_GT(k6.closest, 0.6 * topo.inter_distance_m) << "k nearest keep clear of each other";
   EXPECT_LT(k6.widest_gap, 1.25 * topo.inter_distance_m) << "and near their neighbours";
   EXPECT_TRUE(k6.connected) << "one swarm, not islands";

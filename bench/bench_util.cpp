@@ -41,7 +41,8 @@ pid_t spawn(const std::vector<std::string>& argv, const std::string& log_file) {
   if (pid == 0) {
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(127);
-    int fd = open(log_file.empty() ? "/dev/null" : log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int fd =
+        open(log_file.empty() ? "/dev/null" : log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd >= 0) {
       dup2(fd, STDOUT_FILENO);
       dup2(fd, STDERR_FILENO);
@@ -88,8 +89,8 @@ int free_udp_port() {
 }
 
 pid_t start_discovery_server(int port, const std::string& log_file) {
-  return spawn({"fast-discovery-server", "-i", "0", "-l", "127.0.0.1", "-p", std::to_string(port), "-x",
-                std::string(DDSWARM_CONFIG_DIR) + "/discovery_server.xml"},
+  return spawn({"fast-discovery-server", "-i", "0", "-l", "127.0.0.1", "-p", std::to_string(port),
+                "-x", std::string(DDSWARM_CONFIG_DIR) + "/discovery_server.xml"},
                log_file);
 }
 

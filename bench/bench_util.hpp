@@ -20,10 +20,10 @@ int free_udp_port();
 pid_t start_discovery_server(int port, const std::string& log_file = "");
 
 struct ProcSample {
-  std::string comm;     ///< executable name (15 characters at most)
-  double cpu_s = 0;     ///< user + system CPU seconds so far
-  long rss_kb = 0;      ///< resident set
-  long pss_kb = 0;      ///< proportional set (shared pages split), 0 when unreadable
+  std::string comm;  ///< executable name (15 characters at most)
+  double cpu_s = 0;  ///< user + system CPU seconds so far
+  long rss_kb = 0;   ///< resident set
+  long pss_kb = 0;   ///< proportional set (shared pages split), 0 when unreadable
   int threads = 0;
 };
 /// Reads /proc/<pid>; false when the process is gone.

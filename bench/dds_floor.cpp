@@ -8,8 +8,8 @@
 // profiles as ddswarm. Measures discovery time, idle CPU after discovery and
 // ticks/s after a warm-up, with simple discovery and with the Fast DDS
 // discovery server.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -58,12 +58,13 @@ msg::SwarmState make_state(int n) {
 }
 
 std::string g_profiles;  // --profiles: a QoS profiles file other than ddswarm's
-double g_work_us = 0;  // --work-us: the publisher's CPU between ticks, standing in for physics
+double g_work_us = 0;    // --work-us: the publisher's CPU between ticks, standing in for physics
 // --physics-hz: the publisher steps a lockstep server's physics between ticks;
 // --physics-scenario: whose scene, formation, airframe, controller and sensors.
 double g_physics_hz = 0;
 std::string g_physics_scenario;
-bool g_best_effort = false;  // --best-effort-streams: read the two streams as a real-time swarm does
+bool g_best_effort =
+    false;  // --best-effort-streams: read the two streams as a real-time swarm does
 Delivery stream_delivery() { return g_best_effort ? Delivery::kLatest : Delivery::kProfile; }
 
 DdsConfig dds_for(int domain, const std::string& server, int participant_id = -1) {
@@ -91,15 +92,17 @@ int respond(int id, int domain, const std::string& server, double duration_s, in
   msg::VelocityCommand cmd;
   cmd.drone_id(static_cast<std::uint16_t>(id));
   cmd.motors_on(true);
-  p.reader<msg::SwarmState>([&](const msg::SwarmState& s, const fdds::SampleInfo&) {
-    // Read what an agent reads: its own state and every peer's position.
-    double sx = 0;
-    for (const auto& d : s.drones()) sx += d.position().x();
-    cmd.tick(s.tick());
-    cmd.sim_time_s(s.sim_time_s());
-    cmd.velocity().x(id < static_cast<int>(s.drones().size()) ? -sx * 1e-6 : 0);
-    w.write(cmd);
-  }, std::nullopt, stream_delivery());
+  p.reader<msg::SwarmState>(
+      [&](const msg::SwarmState& s, const fdds::SampleInfo&) {
+        // Read what an agent reads: its own state and every peer's position.
+        double sx = 0;
+        for (const auto& d : s.drones()) sx += d.position().x();
+        cmd.tick(s.tick());
+        cmd.sim_time_s(s.sim_time_s());
+        cmd.velocity().x(id < static_cast<int>(s.drones().size()) ? -sx * 1e-6 : 0);
+        w.write(cmd);
+      },
+      std::nullopt, stream_delivery());
   wait_for_stop(std::chrono::duration<double>(duration_s));
   p.close();
   return 0;
@@ -138,8 +141,9 @@ double cpu_between(const std::map<pid_t, ProcSample>& a, const std::map<pid_t, P
   return s;
 }
 
-Result run_one(int n, bool use_server, bool explicit_ids, int domain, double warmup_s, double measure_s,
-               double idle_s, double discovery_timeout_s, const std::string& log_dir) {
+Result run_one(int n, bool use_server, bool explicit_ids, int domain, double warmup_s,
+               double measure_s, double idle_s, double discovery_timeout_s,
+               const std::string& log_dir) {
   Result r;
   r.n = n;
   r.discovery = use_server ? "server" : "simple";
@@ -167,8 +171,13 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
   }
   const double child_budget = discovery_timeout_s + warmup_s + measure_s + idle_s + 30;
   for (int i = 0; i < n; ++i) {
-    std::vector<std::string> a = {self_exe(), "--respond", std::to_string(i), "--domain", std::to_string(domain),
-                                  "--duration", fmt::format("{:.0f}", child_budget)};
+    std::vector<std::string> a = {self_exe(),
+                                  "--respond",
+                                  std::to_string(i),
+                                  "--domain",
+                                  std::to_string(domain),
+                                  "--duration",
+                                  fmt::format("{:.0f}", child_budget)};
     if (!g_profiles.empty()) a.insert(a.end(), {"--profiles", g_profiles});
     if (g_best_effort) a.push_back("--best-effort-streams");
     if (use_server) {
@@ -191,19 +200,23 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
     std::uint64_t tick = 0;
     std::vector<char> answered(n, 0);
     int count = 0;
-    auto& rd = p.reader<msg::VelocityCommand>([&](const msg::VelocityCommand& c, const fdds::SampleInfo&) {
-      std::lock_guard<std::mutex> lock(mu);
-      if (c.tick() != tick || c.drone_id() >= n || answered[c.drone_id()]) return;
-      answered[c.drone_id()] = 1;
-      if (++count == n) cv.notify_all();
-    }, std::nullopt, stream_delivery());
+    auto& rd = p.reader<msg::VelocityCommand>(
+        [&](const msg::VelocityCommand& c, const fdds::SampleInfo&) {
+          std::lock_guard<std::mutex> lock(mu);
+          if (c.tick() != tick || c.drone_id() >= n || answered[c.drone_id()]) return;
+          answered[c.drone_id()] = 1;
+          if (++count == n) cv.notify_all();
+        },
+        std::nullopt, stream_delivery());
     // Discovery: every responder's reader and writer matched with ours.
-    while (!stop_requested() && (w.matched() < n || rd.matched() < n) && wall_seconds() - t0 < discovery_timeout_s)
+    while (!stop_requested() && (w.matched() < n || rd.matched() < n) &&
+           wall_seconds() - t0 < discovery_timeout_s)
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     r.discovery_s = wall_seconds() - t0;
     if (w.matched() < n || rd.matched() < n) {
-      r.why = fmt::format("discovery incomplete after {:.0f} s: {}/{} readers, {}/{} writers matched",
-                          r.discovery_s, w.matched(), n, rd.matched(), n);
+      r.why =
+          fmt::format("discovery incomplete after {:.0f} s: {}/{} readers, {}/{} writers matched",
+                      r.discovery_s, w.matched(), n, rd.matched(), n);
     } else {
       // Idle cost once discovered: the participants' announcements and liveliness.
       auto a = sample_all(all);
@@ -289,13 +302,16 @@ Result run_one(int n, bool use_server, bool explicit_ids, int domain, double war
   return r;
 }
 
-std::string fmt_num(double v, const char* f) { return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : "-"; }
+std::string fmt_num(double v, const char* f) {
+  return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : "-";
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
   return run_main("dds_floor", [&]() -> int {
-    CLI::App app{"dds_floor: the bare Fast DDS lockstep floor (one whole-swarm sample out, N answers back)"};
+    CLI::App app{
+        "dds_floor: the bare Fast DDS lockstep floor (one whole-swarm sample out, N answers back)"};
     std::vector<int> sizes = {6, 16, 32, 64, 128};
     std::string discovery = "both", csv, log_dir;
     double warmup_s = 2, measure_s = 5, idle_s = 2, discovery_timeout_s = 120, duration_s = 600;
@@ -305,15 +321,19 @@ int main(int argc, char** argv) {
     app.add_option("--drones", sizes, "swarm sizes to measure")->delimiter(',');
     app.add_option("--discovery", discovery, "simple | server | both")
         ->check(CLI::IsMember({"simple", "server", "both"}));
-    app.add_option("--simple-max", simple_max,
-                   "largest N run with simple discovery (N=128 takes ~90 s to discover, and more than "
-                   "~100 participants need explicit ids)");
+    app.add_option(
+        "--simple-max", simple_max,
+        "largest N run with simple discovery (N=128 takes ~90 s to discover, and more than "
+        "~100 participants need explicit ids)");
     app.add_option("--warmup", warmup_s, "s of lockstep before measuring");
     app.add_option("--time", measure_s, "s of lockstep measured");
     app.add_option("--idle", idle_s, "s of idle CPU measured after discovery");
     app.add_option("--discovery-timeout", discovery_timeout_s, "s to wait for discovery");
-    app.add_option("--domain", domain, "DDS domain (default: random in 20-79, whose RTPS ports stay below the ephemeral port range)");
-    app.add_option("--profiles", g_profiles, "QoS profiles XML (default: ddswarm's config/dds_profiles.xml)")
+    app.add_option("--domain", domain,
+                   "DDS domain (default: random in 20-79, whose RTPS ports stay below the "
+                   "ephemeral port range)");
+    app.add_option("--profiles", g_profiles,
+                   "QoS profiles XML (default: ddswarm's config/dds_profiles.xml)")
         ->check(CLI::ExistingFile);
     app.add_option("--work-us", g_work_us,
                    "µs the publisher spends busy between ticks, as a server steps physics there "
@@ -333,15 +353,20 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     app.add_flag("--best-effort-streams", g_best_effort,
                  "read the swarm state and the commands best-effort, as ddswarm does by default "
-                 "(dds.best_effort_streams; writers stay reliable; a lost tick is re-published after 0.25 s)");
+                 "(dds.best_effort_streams; writers stay reliable; a lost tick is re-published "
+                 "after 0.25 s)");
     app.add_option("--csv", csv, "append one row per run to this CSV");
-    app.add_option("--log-dir", log_dir, "responder and discovery-server logs (default: discarded)");
-    app.add_flag("--explicit-ids", explicit_ids,
-                 "give every participant its RTPS participant id (publisher 0, responder i: i+1) instead of "
-                 "Fast DDS's automatic one (needs N < dds.participant_id's limit for the domain)");
-    app.add_option("--participant-id", participant_id, "internal: responder's participant id")->group("");
+    app.add_option("--log-dir", log_dir,
+                   "responder and discovery-server logs (default: discarded)");
+    app.add_flag(
+        "--explicit-ids", explicit_ids,
+        "give every participant its RTPS participant id (publisher 0, responder i: i+1) instead of "
+        "Fast DDS's automatic one (needs N < dds.participant_id's limit for the domain)");
+    app.add_option("--participant-id", participant_id, "internal: responder's participant id")
+        ->group("");
     app.add_option("--respond", respond_id, "internal: run as responder ID")->group("");
-    app.add_option("--discovery-server", server, "internal: responder's discovery server")->group("");
+    app.add_option("--discovery-server", server, "internal: responder's discovery server")
+        ->group("");
     app.add_option("--duration", duration_s, "internal: responder's lifetime (s)")->group("");
     try {
       app.parse(argc, argv);
@@ -367,17 +392,20 @@ int main(int argc, char** argv) {
           results.push_back(r);
           continue;
         }
-        std::fprintf(stderr, "dds_floor: N=%d, %s discovery ...\n", n, use_server ? "server" : "simple");
+        std::fprintf(stderr, "dds_floor: N=%d, %s discovery ...\n", n,
+                     use_server ? "server" : "simple");
         if (explicit_ids && n > max_participant_id(domain) - 1) {
           Result r;
           r.n = n;
           r.discovery = use_server ? "server" : "simple";
-          r.why = fmt::format("skipped: explicit ids need N <= {} in domain {} (dds.participant_id range)",
-                              max_participant_id(domain) - 1, domain);
+          r.why = fmt::format(
+              "skipped: explicit ids need N <= {} in domain {} (dds.participant_id range)",
+              max_participant_id(domain) - 1, domain);
           results.push_back(r);
           continue;
         }
-        Result r = run_one(n, use_server, explicit_ids, domain, warmup_s, measure_s, idle_s, discovery_timeout_s, log_dir);
+        Result r = run_one(n, use_server, explicit_ids, domain, warmup_s, measure_s, idle_s,
+                           discovery_timeout_s, log_dir);
         std::fprintf(stderr, "dds_floor: N=%d %s: %s\n", n, r.discovery.c_str(),
                      r.ok ? fmt::format("{:.0f} ticks/s", r.ticks_per_s).c_str() : r.why.c_str());
         results.push_back(r);

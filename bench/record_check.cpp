@@ -29,7 +29,9 @@ int main(int argc, char** argv) {
   // step: the gcd of every tick's distance from the first, so a stream sent
   // every k-th tick (scans at a sensor rate below the control rate) counts
   // only the ticks it would have sent as gaps.
-  struct Stream { std::uint64_t first = 0, last = 0, n = 0, step = 0; };
+  struct Stream {
+    std::uint64_t first = 0, last = 0, n = 0, step = 0;
+  };
   std::map<std::string, std::map<int, Stream>> ticks;  // topic -> drone (-1: whole swarm) -> ticks
   std::map<std::string, std::uint64_t> count, bytes;
   std::uint64_t t0 = ~0ULL, t1 = 0;
@@ -71,11 +73,13 @@ int main(int argc, char** argv) {
     gap |= missing > 0;
     total += n;
     total_bytes += bytes[topic];
-    std::printf("%-24s %10llu %12.0f %10.2f %10llu\n", topic.c_str(), static_cast<unsigned long long>(n),
-                n / dur, bytes[topic] / dur / 1e6, static_cast<unsigned long long>(missing));
+    std::printf("%-24s %10llu %12.0f %10.2f %10llu\n", topic.c_str(),
+                static_cast<unsigned long long>(n), n / dur, bytes[topic] / dur / 1e6,
+                static_cast<unsigned long long>(missing));
   }
-  std::printf("%-24s %10llu %12.0f %10.2f   over %.1f s (%s)\n", "total", static_cast<unsigned long long>(total),
-              total / dur, total_bytes / dur / 1e6, dur, r.how_read().describe().c_str());
+  std::printf("%-24s %10llu %12.0f %10.2f   over %.1f s (%s)\n", "total",
+              static_cast<unsigned long long>(total), total / dur, total_bytes / dur / 1e6, dur,
+              r.how_read().describe().c_str());
   if (total == 0) {
     std::fprintf(stderr, "record_check: %s holds no message\n", argv[1]);
     return 1;

@@ -28,11 +28,11 @@ namespace {
 
 struct AgeStats {
   std::vector<long> hist = std::vector<long>(64, 0);  // command age in control periods
-  long drone_ticks = 0;                              // drone-ticks measured
-  long missed = 0;                                   // commands never applied
+  long drone_ticks = 0;                               // drone-ticks measured
+  long missed = 0;                                    // commands never applied
   long samples = 0, probe_gaps = 0;
   std::uint64_t last_tick = 0;
-  std::vector<std::int64_t> last_applied;            // per drone, -1 = unknown
+  std::vector<std::int64_t> last_applied;  // per drone, -1 = unknown
   // Per drone: are the misses a few drones' or everyone's?
   std::vector<long> missed_by_drone;
   // Misses seen in a sample where half the swarm or more missed at once.
@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
     bool ages = false;
     DdsConfig dds;
     app.add_option("--drones", drones, "drones that must be airborne before measuring")->required();
-    app.add_option("--launcher-pid", launcher, "CPU and memory of this process and its descendants");
+    app.add_option("--launcher-pid", launcher,
+                   "CPU and memory of this process and its descendants");
     app.add_option("--settle", settle_s, "s of wall time after all are airborne, before measuring");
     app.add_option("--time", time_s, "s of wall time measured");
     app.add_option("--timeout", timeout_s, "s to wait for the swarm to be airborne");
@@ -122,7 +123,8 @@ int main(int argc, char** argv) {
         if (control_rate_hz <= 0) return;
         const double period = 1.0 / control_rate_hz;
         const bool consecutive = ag.samples > 0 && s.tick() == ag.last_tick + 1;
-        if (ag.samples > 0 && s.tick() > ag.last_tick + 1) ag.probe_gaps += s.tick() - ag.last_tick - 1;
+        if (ag.samples > 0 && s.tick() > ag.last_tick + 1)
+          ag.probe_gaps += s.tick() - ag.last_tick - 1;
         ++ag.samples;
         ag.last_tick = s.tick();
         long tick_missed = 0;
@@ -180,7 +182,8 @@ int main(int argc, char** argv) {
         ++joins;
       }
       if (wall_seconds() - t0 > timeout_s) {
-        std::printf("probe ok=0 why=airborne_%d_of_%d_after_%.0fs\n", ok ? s.airborne() : 0, drones, timeout_s);
+        std::printf("probe ok=0 why=airborne_%d_of_%d_after_%.0fs\n", ok ? s.airborne() : 0, drones,
+                    timeout_s);
         return 1;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -227,12 +230,12 @@ int main(int argc, char** argv) {
     for (const auto& [pid, b] : cpu1) {
       auto it = cpu0.find(pid);
       if (it == cpu0.end()) continue;
-      std::string kind = pid == getpid() ? "probe"
-                         : b.comm == "ddswarm-sim"    ? "sim"
-                         : b.comm == "ddswarm-agent"  ? "agents"
-                         : b.comm == "ddswarm-launch" ? "launcher"
+      std::string kind = pid == getpid()                          ? "probe"
+                         : b.comm == "ddswarm-sim"                ? "sim"
+                         : b.comm == "ddswarm-agent"              ? "agents"
+                         : b.comm == "ddswarm-launch"             ? "launcher"
                          : b.comm.rfind("fast-discovery", 0) == 0 ? "ds"
-                                                                   : "other";
+                                                                  : "other";
       cpu[kind] += (b.cpu_s - it->second.cpu_s) / dw;
       ++count[kind];
       if (kind == "agents") {
@@ -244,20 +247,25 @@ int main(int argc, char** argv) {
     }
     const int na = std::max(1, count["agents"]);
     std::string line = fmt::format(
-        "probe ok=1 drones={} ticks_per_s={:.1f} rtf={:.3f} window_s={:.1f} status_rtf={:.3f} agents_seen={} "
-        "cpu_sim={:.3f} cpu_agents={:.3f} cpu_agent_each={:.4f} cpu_ds={:.3f} cpu_launcher={:.3f} cpu_probe={:.3f} "
-        "cpu_other={:.3f} rss_agent_mb={:.1f} rss_agent_max_mb={:.1f} pss_agent_mb={:.1f} agent_threads={}",
-        drones, ticks_per_s, rtf, server_dw, s1.real_time_factor(), count["agents"], cpu["sim"], cpu["agents"],
-        cpu["agents"] / na, cpu["ds"], cpu["launcher"], cpu["probe"], cpu["other"], agent_rss / na, agent_rss_max,
-        agent_pss / na, agent_threads);
+        "probe ok=1 drones={} ticks_per_s={:.1f} rtf={:.3f} window_s={:.1f} status_rtf={:.3f} "
+        "agents_seen={} "
+        "cpu_sim={:.3f} cpu_agents={:.3f} cpu_agent_each={:.4f} cpu_ds={:.3f} cpu_launcher={:.3f} "
+        "cpu_probe={:.3f} "
+        "cpu_other={:.3f} rss_agent_mb={:.1f} rss_agent_max_mb={:.1f} pss_agent_mb={:.1f} "
+        "agent_threads={}",
+        drones, ticks_per_s, rtf, server_dw, s1.real_time_factor(), count["agents"], cpu["sim"],
+        cpu["agents"], cpu["agents"] / na, cpu["ds"], cpu["launcher"], cpu["probe"], cpu["other"],
+        agent_rss / na, agent_rss_max, agent_pss / na, agent_threads);
     if (ages) {
       std::lock_guard<std::mutex> lock(mu);
       line += fmt::format(
-          " age_p50_periods={} age_p99_periods={} age_max_periods={} missed={} drone_ticks={} missed_frac={:.5f} "
+          " age_p50_periods={} age_p99_periods={} age_max_periods={} missed={} drone_ticks={} "
+          "missed_frac={:.5f} "
           "probe_samples={} probe_gaps={} failsafe={} commands_applied={} lockstep_timeouts={}",
-          percentile(ag.hist, 0.5), percentile(ag.hist, 0.99), percentile(ag.hist, 1.0), ag.missed, ag.drone_ticks,
-          ag.drone_ticks ? static_cast<double>(ag.missed) / ag.drone_ticks : NAN, ag.samples, ag.probe_gaps,
-          s1.failsafe(), s1.commands_applied() - s0.commands_applied(), s1.lockstep_timeouts());
+          percentile(ag.hist, 0.5), percentile(ag.hist, 0.99), percentile(ag.hist, 1.0), ag.missed,
+          ag.drone_ticks, ag.drone_ticks ? static_cast<double>(ag.missed) / ag.drone_ticks : NAN,
+          ag.samples, ag.probe_gaps, s1.failsafe(), s1.commands_applied() - s0.commands_applied(),
+          s1.lockstep_timeouts());
       line += " " + miss_spread(ag.missed_by_drone);
       line += fmt::format(" missed_in_stalls={:.3f}",
                           ag.missed ? static_cast<double>(ag.missed_in_stalls) / ag.missed : 0.0);

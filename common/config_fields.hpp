@@ -37,12 +37,18 @@ struct Bounds {
   /// As the reference writes it: "> 0", ">= 0", "[0, 1]", "0 or [2, 3600]", "(0, 1000]".
   std::string text() const {
     switch (kind) {
-      case Kind::kAny: return "";
-      case Kind::kPositive: return "> 0";
-      case Kind::kNonNegative: return ">= 0";
-      case Kind::kRange: return "[" + to_text(lo) + ", " + to_text(hi) + "]";
-      case Kind::kZeroOrRange: return "0 or [" + to_text(lo) + ", " + to_text(hi) + "]";
-      case Kind::kAtMost: return "(0, " + to_text(hi) + "]";
+      case Kind::kAny:
+        return "";
+      case Kind::kPositive:
+        return "> 0";
+      case Kind::kNonNegative:
+        return ">= 0";
+      case Kind::kRange:
+        return "[" + to_text(lo) + ", " + to_text(hi) + "]";
+      case Kind::kZeroOrRange:
+        return "0 or [" + to_text(lo) + ", " + to_text(hi) + "]";
+      case Kind::kAtMost:
+        return "(0, " + to_text(hi) + "]";
     }
     return "";
   }
@@ -51,16 +57,21 @@ struct Bounds {
   template <class T>
   void check(const std::string& field, T v) const {
     switch (kind) {
-      case Kind::kAny: return;
-      case Kind::kPositive: return check_positive(field, v);
-      case Kind::kNonNegative: return check_non_negative(field, v);
-      case Kind::kRange: return check_range(field, v, static_cast<T>(lo), static_cast<T>(hi));
+      case Kind::kAny:
+        return;
+      case Kind::kPositive:
+        return check_positive(field, v);
+      case Kind::kNonNegative:
+        return check_non_negative(field, v);
+      case Kind::kRange:
+        return check_range(field, v, static_cast<T>(lo), static_cast<T>(hi));
       case Kind::kZeroOrRange:
         if (v != 0) check_range(field, v, static_cast<T>(lo), static_cast<T>(hi));
         return;
       case Kind::kAtMost:
         check_positive(field, v);
-        if (v > static_cast<T>(hi)) throw FieldError(field, to_text(v), "must be <= " + to_text(hi));
+        if (v > static_cast<T>(hi))
+          throw FieldError(field, to_text(v), "must be <= " + to_text(hi));
         return;
     }
   }
@@ -78,7 +89,7 @@ inline Bounds up_to(double hi) { return {Bounds::Kind::kAtMost, 0, hi}; }
 struct FieldSpec {
   const char* unit = "";  ///< "m", "m/s", "s (wall)", ...; empty when unitless
   Bounds bounds;
-  const char* doc = "";   ///< one line: what the field does
+  const char* doc = "";  ///< one line: what the field does
 };
 
 /// An enum field's names, in the order the reference lists them.
@@ -127,7 +138,8 @@ class FieldChecker {
   explicit FieldChecker(std::string prefix) : prefix_(std::move(prefix)) {}
   template <class T>
   void field(const char* key, const T& v, const FieldSpec& spec) {
-    if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) spec.bounds.check(prefix_ + "." + key, v);
+    if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>)
+      spec.bounds.check(prefix_ + "." + key, v);
   }
   template <class E>
   void choice(const char*, const E&, const Choices<E>&, const FieldSpec&) {}
@@ -154,7 +166,7 @@ struct FieldRow {
   std::string type;          ///< "real", "integer", "bool", "text", "list", or "a | b | c"
   std::string default_text;  ///< as YAML would write it
   std::string unit;
-  std::string bounds;        ///< Bounds::text()
+  std::string bounds;  ///< Bounds::text()
   std::string doc;
 };
 
@@ -175,7 +187,10 @@ class FieldLister {
       def = to_text(v);
     } else if constexpr (std::is_same_v<T, std::string>) {
       def = v;
-    } else if constexpr (requires { v.rows(); v.cols(); }) {  // an Eigen vector
+    } else if constexpr (requires {
+                           v.rows();
+                           v.cols();
+                         }) {  // an Eigen vector
       type = v.size() == 2 ? "[x, y]" : "[x, y, z]";
       for (int k = 0; k < v.size(); ++k) def += (k ? ", " : "[") + to_text(v[k]);
       def += "]";

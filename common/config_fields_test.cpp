@@ -72,7 +72,8 @@ Some words.
 }  // namespace
 
 TEST(ConfigFields, OneListLoadsChecksAndDescribes) {
-  const ToyConfig c = load_toy("toy: {mode: fast, speed_mps: 4, retries: 0, loud: true, timeout_s: 5}\n");
+  const ToyConfig c =
+      load_toy("toy: {mode: fast, speed_mps: 4, retries: 0, loud: true, timeout_s: 5}\n");
   EXPECT_EQ(c.mode, Mode::kFast);
   EXPECT_EQ(c.speed_mps, 4);
   EXPECT_EQ(c.retries, 0);
@@ -96,7 +97,8 @@ TEST(ConfigFields, OneListLoadsChecksAndDescribes) {
 TEST(ConfigFields, ABadValueNamesFileLineFieldAndBound) {
   EXPECT_EQ(error_of("toy:\n  speed_mps: -1\n"), "toy.yaml:2: toy.speed_mps = -1: must be > 0");
   EXPECT_EQ(error_of("toy:\n  retries: 11\n"), "toy.yaml:2: toy.retries = 11: must be in [0, 10]");
-  EXPECT_EQ(error_of("toy:\n  timeout_s: 1\n"), "toy.yaml:2: toy.timeout_s = 1: must be in [2, 60]");
+  EXPECT_EQ(error_of("toy:\n  timeout_s: 1\n"),
+            "toy.yaml:2: toy.timeout_s = 1: must be in [2, 60]");
   EXPECT_EQ(error_of("toy:\n  timeout_s: 0\n"), "");
   EXPECT_NE(error_of("toy:\n  mode: medium\n").find("toy.mode = medium: must be one of fast|slow"),
             std::string::npos);
@@ -104,7 +106,8 @@ TEST(ConfigFields, ABadValueNamesFileLineFieldAndBound) {
 }
 
 TEST(ConfigFields, TheReferenceAgreesWithTheList) {
-  EXPECT_EQ(reference_mismatches(kDoc, "### `toy:`", field_rows<ToyConfig>()), std::vector<std::string>{});
+  EXPECT_EQ(reference_mismatches(kDoc, "### `toy:`", field_rows<ToyConfig>()),
+            std::vector<std::string>{});
 }
 
 TEST(ConfigFields, TheReferenceDriftingFromTheListIsCaught) {
@@ -123,6 +126,7 @@ TEST(ConfigFields, TheReferenceDriftingFromTheListIsCaught) {
   const auto renamed = drift("| `loud` |", "| `noisy` |");
   ASSERT_EQ(renamed.size(), 2u);
   EXPECT_NE(renamed[0].find("no row for loud"), std::string::npos);
-  EXPECT_NE(renamed[1].find("the doc has a row for noisy, which the code does not list"), std::string::npos);
+  EXPECT_NE(renamed[1].find("the doc has a row for noisy, which the code does not list"),
+            std::string::npos);
   EXPECT_TRUE(one(reference_mismatches(kDoc, "### `tiy:`", field_rows<ToyConfig>()), "no heading"));
 }

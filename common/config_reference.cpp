@@ -57,7 +57,8 @@ bool scalar_type(const std::string& t) {
 
 }  // namespace
 
-std::vector<std::string> reference_mismatches(const std::string& markdown, const std::string& heading,
+std::vector<std::string> reference_mismatches(const std::string& markdown,
+                                              const std::string& heading,
                                               const std::vector<FieldRow>& rows) {
   std::istringstream in(markdown);
   std::string line;
@@ -103,22 +104,25 @@ std::vector<std::string> reference_mismatches(const std::string& markdown, const
         placeholder ? r.default_text.size() >= def.size() - close - 1 &&
                           r.default_text.compare(r.default_text.size() - (def.size() - close - 1),
                                                  std::string::npos, def.substr(close + 1)) == 0
-        : number(def, &a) && number(r.default_text, &b) ? a == b
-                                                        : (def == "\"\"" ? "" : def) == r.default_text;
+        : number(def, &a) && number(r.default_text, &b)
+            ? a == b
+            : (def == "\"\"" ? "" : def) == r.default_text;
     if (!same_default)
       out.push_back(heading + ": " + r.key + ": the doc's default is '" + def + "', the code's '" +
                     r.default_text + "'");
     if (unit != r.unit)
-      out.push_back(heading + ": " + r.key + ": the doc's unit is '" + unit + "', the code's '" + r.unit + "'");
+      out.push_back(heading + ": " + r.key + ": the doc's unit is '" + unit + "', the code's '" +
+                    r.unit + "'");
     if (range.rfind(r.bounds, 0) != 0)
-      out.push_back(heading + ": " + r.key + ": the doc's range '" + range + "' does not begin with the code's '" +
-                    r.bounds + "'");
+      out.push_back(heading + ": " + r.key + ": the doc's range '" + range +
+                    "' does not begin with the code's '" + r.bounds + "'");
     if (r.type.find(" | ") != std::string::npos) {
       std::istringstream names(r.type);
       std::string name, row = c[1] + " " + c[4];
       while (names >> name)
         if (name != "|" && row.find("`" + name + "`") == std::string::npos)
-          out.push_back(heading + ": " + r.key + ": the doc does not name the choice '" + name + "'");
+          out.push_back(heading + ": " + r.key + ": the doc does not name the choice '" + name +
+                        "'");
     }
   }
   for (const auto& [key, c] : table)

@@ -16,7 +16,8 @@ namespace ddswarm {
 /// heading (e.g. "### `comm:`"). A doc default is compared as a number where
 /// both are numbers; a doc range cell must begin with the bounds' text; an
 /// enum's every name must appear in its row.
-std::vector<std::string> reference_mismatches(const std::string& markdown, const std::string& heading,
+std::vector<std::string> reference_mismatches(const std::string& markdown,
+                                              const std::string& heading,
                                               const std::vector<FieldRow>& rows);
 
 /// The text of docs/configuration.md in the source tree.

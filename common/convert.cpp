@@ -6,8 +6,8 @@ namespace ddswarm {
 
 std::string mission_problem(const msg::MissionCommand& m) {
   if (m.type() < 1 || m.type() > 8) return "unknown command type " + std::to_string(m.type());
-  const double vals[] = {m.velocity().x(), m.velocity().y(), m.velocity().z(), m.duration_s(),
-                         m.value(), m.epsilon_m()};
+  const double vals[] = {m.velocity().x(), m.velocity().y(), m.velocity().z(),
+                         m.duration_s(),   m.value(),        m.epsilon_m()};
   for (double v : vals)
     if (!std::isfinite(v)) return "non-finite value";
   if (from_msg(m.velocity()).norm() > 50.0) return "velocity beyond 50 m/s";
@@ -73,7 +73,8 @@ SceneConfig from_msg(const msg::Scene& s) {
   c.ground_z_m = s.ground_z_m();
   for (const auto& cy : s.cylinders())
     c.cylinders.push_back({Eigen::Vector2d(cy.x(), cy.y()), cy.radius_m(), cy.height_m()});
-  for (const auto& b : s.boxes()) c.boxes.push_back({from_msg(b.center()), from_msg(b.size()), b.yaw_rad()});
+  for (const auto& b : s.boxes())
+    c.boxes.push_back({from_msg(b.center()), from_msg(b.size()), b.yaw_rad()});
   c.bounds_min = from_msg(s.bounds_min());
   c.bounds_max = from_msg(s.bounds_max());
   c.finish_a = from_msg(s.finish_a()).head<2>();

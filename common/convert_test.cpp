@@ -63,7 +63,8 @@ TEST(Convert, AMissionCommandAndItsAckKeepEveryField) {
   EXPECT_EQ(back.epsilon_m, c.epsilon_m);
   EXPECT_EQ(back.issuer, c.issuer);
 
-  const msg::MissionAck a = to_msg(MissionAck{3, 42, false, "not airborne", Phase::kIdle, 900}, 0xabc);
+  const msg::MissionAck a =
+      to_msg(MissionAck{3, 42, false, "not airborne", Phase::kIdle, 900}, 0xabc);
   EXPECT_EQ(a.drone_id(), 3);
   EXPECT_EQ(a.seq(), 42u);
   EXPECT_FALSE(a.accepted());

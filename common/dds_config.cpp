@@ -1,14 +1,14 @@
 #include "common/dds_config.hpp"
 
+#include <arpa/inet.h>
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <arpa/inet.h>
 
+#include <ifaddrs.h>
+#include <netinet/in.h>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <ifaddrs.h>
-#include <netinet/in.h>
 
 #include "common/yaml_section.hpp"
 
@@ -91,12 +91,13 @@ void DdsConfig::validate() const {
   }
   if (discovery == Discovery::kDiscoveryServer) {
     if (!is_ipv4(host_of(discovery_server)))
-      throw FieldError("dds.discovery_server", discovery_server.empty() ? "(empty)" : discovery_server,
-                       "must be ip:port");
+      throw FieldError("dds.discovery_server",
+                       discovery_server.empty() ? "(empty)" : discovery_server, "must be ip:port");
     if (host_of(discovery_server) != "127.0.0.1" && interface_ip.empty())
-      throw FieldError("dds.interface_ip", "(empty)",
-                       "a discovery server on another host needs this host's address on that network "
-                       "(--dds-local-ip)");
+      throw FieldError(
+          "dds.interface_ip", "(empty)",
+          "a discovery server on another host needs this host's address on that network "
+          "(--dds-local-ip)");
   }
   if (secure() && discovery == Discovery::kDiscoveryServer)
     throw FieldError("dds.discovery_server", discovery_server,
@@ -104,10 +105,12 @@ void DdsConfig::validate() const {
                      "discovery server (docs/security.md)");
   if (secure()) {
     if (security_role.empty() ||
-        security_role.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
+        security_role.find_first_not_of(
+            "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
             std::string::npos)
-      throw FieldError("dds.security_role", security_role.empty() ? "(empty)" : security_role,
-                       "must name an identity made by scripts/make-certs, e.g. server, gs, recorder, agent-3");
+      throw FieldError(
+          "dds.security_role", security_role.empty() ? "(empty)" : security_role,
+          "must name an identity made by scripts/make-certs, e.g. server, gs, recorder, agent-3");
     std::string missing;
     for (const auto& f : security_files()) {
       std::error_code ec;
@@ -116,19 +119,24 @@ void DdsConfig::validate() const {
     }
     if (!missing.empty())
       throw FieldError("dds.secure", security_dir,
-                       "missing " + missing + " for role " + security_role + " (make them with scripts/make-certs --out " +
-                           security_dir + ")");
+                       "missing " + missing + " for role " + security_role +
+                           " (make them with scripts/make-certs --out " + security_dir + ")");
   }
   // Fast DDS silently drops a whitelisted address this host does not have,
   // which would leave the process unreachable without a word.
-  if (!interface_ip.empty() && discovery != Discovery::kLocalhost && !is_local_address(interface_ip))
+  if (!interface_ip.empty() && discovery != Discovery::kLocalhost &&
+      !is_local_address(interface_ip))
     throw FieldError("dds.interface_ip", interface_ip, "is not an address of this host");
 }
 
 std::vector<std::string> DdsConfig::security_files() const {
   const std::string d = security_dir + "/";
-  return {d + "identity_ca.cert.pem", d + "permissions_ca.cert.pem", d + "governance.p7s",
-          d + security_role + ".permissions.p7s", d + security_role + ".cert.pem", d + security_role + ".key.pem"};
+  return {d + "identity_ca.cert.pem",
+          d + "permissions_ca.cert.pem",
+          d + "governance.p7s",
+          d + security_role + ".permissions.p7s",
+          d + security_role + ".cert.pem",
+          d + security_role + ".key.pem"};
 }
 
 void default_security_role(DdsConfig& c, const std::string& role) {
@@ -156,8 +164,9 @@ void add_dds_options(CLI::App& app, DdsConfig& c) {
          "opt in: unicast discovery to these peer IPv4 addresses (needs --dds-local-ip)")
       ->delimiter(',')
       ->group("Networking (default: this machine only)");
-  app.add_option("--dds-local-ip", c.interface_ip,
-                 "with --dds-peers or a remote --discovery-server: this host's address on that network")
+  app.add_option(
+         "--dds-local-ip", c.interface_ip,
+         "with --dds-peers or a remote --discovery-server: this host's address on that network")
       ->group("Networking (default: this machine only)");
   app.add_option_function<std::string>(
          "--discovery-server",
@@ -175,9 +184,10 @@ void add_dds_options(CLI::App& app, DdsConfig& c) {
                "real time: the server reads commands and agents read the swarm state best-effort "
                "(dds.best_effort_streams, default on; =false reads them reliably)")
       ->group("Networking (default: this machine only)");
-  app.add_option("--secure", c.security_dir,
-                 "DDS Security: authenticate, access-control and encrypt with the credentials in DIR "
-                 "(made by scripts/make-certs)")
+  app.add_option(
+         "--secure", c.security_dir,
+         "DDS Security: authenticate, access-control and encrypt with the credentials in DIR "
+         "(made by scripts/make-certs)")
       ->type_name("DIR")
       ->group("Security (docs/security.md)");
   app.add_option("--security-role", c.security_role,
@@ -196,7 +206,8 @@ void merge_cli(DdsConfig& target, const DdsConfig& cli, const CLI::App& app) {
     target.peers = cli.peers;
     target.discovery_server = cli.discovery_server;
   }
-  if (app.count("--dds-interface") || app.count("--dds-local-ip")) target.interface_ip = cli.interface_ip;
+  if (app.count("--dds-interface") || app.count("--dds-local-ip"))
+    target.interface_ip = cli.interface_ip;
   if (app.count("--dds-profiles")) target.profiles_file = cli.profiles_file;
   if (app.count("--participant-id")) target.participant_id = cli.participant_id;
   if (app.count("--best-effort-streams")) target.best_effort_streams = cli.best_effort_streams;

@@ -182,15 +182,21 @@ struct DdsConfig {
                                                {"discovery_server", Discovery::kDiscoveryServer}};
     v.field("domain_id", c.domain_id, {"", in(0, kMaxDomainId), "DDS domain"});
     v.choice("discovery", c.discovery, kDiscovery, {"", any(), "how participants find each other"});
-    v.field("interface_ip", c.interface_ip, {"", any(), "interface, peers: this host's address, e.g. 10.10.0.2"});
+    v.field("interface_ip", c.interface_ip,
+            {"", any(), "interface, peers: this host's address, e.g. 10.10.0.2"});
     v.field("peers", c.peers, {"", any(), "peers: the peers' addresses, ip or ip:port"});
-    v.field("discovery_server", c.discovery_server, {"", any(), "discovery_server: ip:port (port 11811 if omitted)"});
-    v.field("shared_memory", c.shared_memory, {"", any(), "the shared-memory transport and data-sharing (same host)"});
-    v.field("shm_transport", c.shm_transport, {"", any(), "with shared_memory: Fast DDS's shared-memory transport too"});
+    v.field("discovery_server", c.discovery_server,
+            {"", any(), "discovery_server: ip:port (port 11811 if omitted)"});
+    v.field("shared_memory", c.shared_memory,
+            {"", any(), "the shared-memory transport and data-sharing (same host)"});
+    v.field("shm_transport", c.shm_transport,
+            {"", any(), "with shared_memory: Fast DDS's shared-memory transport too"});
     v.field("participant_id", c.participant_id, {"", any(), "RTPS participant id; -1 = automatic"});
-    v.field("lease_duration_s", c.lease_duration_s, {"s", in(1, 300), "a silent participant is dropped after this"});
+    v.field("lease_duration_s", c.lease_duration_s,
+            {"s", in(1, 300), "a silent participant is dropped after this"});
     v.field("shm_health_check_s", c.shm_health_check_s,
-            {"s", in(0.1, 60), "how long a process may stall on a shared-memory port before it is made anew"});
+            {"s", in(0.1, 60),
+             "how long a process may stall on a shared-memory port before it is made anew"});
     v.field("profiles_file", c.profiles_file, {"", any(), "the QoS profiles XML"});
     v.field("best_effort_streams", c.best_effort_streams,
             {"", any(), "the swarm's readers of the per-tick streams read them best-effort"});

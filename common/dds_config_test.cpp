@@ -3,10 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include "common/config_error.hpp"
 
@@ -59,7 +59,9 @@ TEST_F(SecureDir, MissingFilesAreNamedInOneLine) {
   } catch (const FieldError& e) {
     const std::string what = e.what();
     EXPECT_EQ(e.field(), "dds.secure");
-    EXPECT_NE(what.find("agent-3.permissions.p7s, agent-3.cert.pem, agent-3.key.pem"), std::string::npos) << what;
+    EXPECT_NE(what.find("agent-3.permissions.p7s, agent-3.cert.pem, agent-3.key.pem"),
+              std::string::npos)
+        << what;
     EXPECT_EQ(what.find("identity_ca"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }

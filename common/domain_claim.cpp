@@ -92,7 +92,8 @@ std::vector<DomainClaim> claim_free_domains(int first, int count,
                                             std::vector<std::string>* why_skipped,
                                             const std::string& dir) {
   std::vector<DomainClaim> out;
-  for (int domain = first; domain <= kMaxDomainId && static_cast<int>(out.size()) < count; ++domain) {
+  for (int domain = first; domain <= kMaxDomainId && static_cast<int>(out.size()) < count;
+       ++domain) {
     DomainClaim c(domain, dir);
     std::string why;
     if (!c.held())

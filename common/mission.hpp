@@ -10,24 +10,24 @@ namespace ddswarm {
 
 enum class MissionType : std::uint8_t {
   kNone = 0,
-  kTakeoff = 1,        ///< climb to value (m above ground; 0 = agent's default) and hold
-  kMove = 2,           ///< fly the swarm at velocity for duration_s, then hold
-  kSetDistance = 3,    ///< change D_int to value (m); mode unchanged
-  kLand = 4,           ///< descend and stop motors
-  kFollowLeader = 5,   ///< leader_id flies velocity (teleop); the rest swarm around it
-  kTask = 6,           ///< fly toward the goal at speed value (m/s) until past the finish, then swarm
-  kHold = 7,           ///< stop mission motion, keep swarming in place
-  kTeleop = 8,         ///< new velocity for the leader during kFollowLeader
+  kTakeoff = 1,       ///< climb to value (m above ground; 0 = agent's default) and hold
+  kMove = 2,          ///< fly the swarm at velocity for duration_s, then hold
+  kSetDistance = 3,   ///< change D_int to value (m); mode unchanged
+  kLand = 4,          ///< descend and stop motors
+  kFollowLeader = 5,  ///< leader_id flies velocity (teleop); the rest swarm around it
+  kTask = 6,    ///< fly toward the goal at speed value (m/s) until past the finish, then swarm
+  kHold = 7,    ///< stop mission motion, keep swarming in place
+  kTeleop = 8,  ///< new velocity for the leader during kFollowLeader
 };
 
 /// Agent's flight phase, reported in every command and heartbeat.
 enum class Phase : std::uint8_t {
-  kIdle = 0,      ///< on the ground, motors off
+  kIdle = 0,  ///< on the ground, motors off
   kTakeoff = 1,
-  kHold = 2,      ///< airborne, swarming in place
+  kHold = 2,  ///< airborne, swarming in place
   kMove = 3,
   kTask = 4,
-  kSwarm = 5,     ///< task: past the finish line, gathering
+  kSwarm = 5,  ///< task: past the finish line, gathering
   kFollow = 6,
   kLanding = 7,
   kFailsafe = 8,  ///< no server samples; not commanding
@@ -37,15 +37,15 @@ const char* to_string(MissionType t);
 const char* to_string(Phase p);
 
 struct MissionCommand {
-  std::uint32_t seq = 0;             ///< increasing per ground station session
+  std::uint32_t seq = 0;  ///< increasing per ground station session
   MissionType type = MissionType::kNone;
-  std::int32_t target = -1;          ///< drone id, or -1 for every drone
-  Eigen::Vector3d velocity{0, 0, 0}; ///< m/s ENU (kMove, kTeleop)
-  double duration_s = 0;             ///< s (kMove)
-  double value = 0;                  ///< kTakeoff altitude m, kSetDistance D_int m, kTask speed m/s
-  std::int32_t leader_id = -1;       ///< kFollowLeader
-  double epsilon_m = 0;              ///< kTask swarm-condition size (0 = default)
-  std::string issuer;                ///< ground station instance name
+  std::int32_t target = -1;           ///< drone id, or -1 for every drone
+  Eigen::Vector3d velocity{0, 0, 0};  ///< m/s ENU (kMove, kTeleop)
+  double duration_s = 0;              ///< s (kMove)
+  double value = 0;             ///< kTakeoff altitude m, kSetDistance D_int m, kTask speed m/s
+  std::int32_t leader_id = -1;  ///< kFollowLeader
+  double epsilon_m = 0;         ///< kTask swarm-condition size (0 = default)
+  std::string issuer;           ///< ground station instance name
 };
 
 struct MissionAck {

@@ -2,13 +2,13 @@
 
 #include "common/shm_clean.hpp"
 
-#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
-#include <fastdds/dds/domain/DomainParticipantListener.hpp>
-#include <fastdds/dds/log/Log.hpp>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/log/Log.hpp>
 
 #include <spdlog/spdlog.h>
 
@@ -58,10 +58,14 @@ void apply_fastdds_log_env() {
   std::call_once(once, [] {
     const char* v = std::getenv("DDSWARM_FASTDDS_LOG");
     const std::string s = v ? v : "";
-    if (s.empty() || s == "off") Log::ClearConsumers();
-    else if (s == "error") Log::SetVerbosity(Log::Error);
-    else if (s == "warning") Log::SetVerbosity(Log::Warning);
-    else if (s == "info") Log::SetVerbosity(Log::Info);
+    if (s.empty() || s == "off")
+      Log::ClearConsumers();
+    else if (s == "error")
+      Log::SetVerbosity(Log::Error);
+    else if (s == "warning")
+      Log::SetVerbosity(Log::Warning);
+    else if (s == "info")
+      Log::SetVerbosity(Log::Info);
     else
       throw DdsError("DDSWARM_FASTDDS_LOG: '" + s + "' is not one of off, error, warning, info");
   });
@@ -79,7 +83,8 @@ void load_profiles_once(const std::string& file) {
   // intraprocess delivery, a participant that closes while another in its
   // process lives on (such as a ground station's status snapshot) leaves a
   // dangling reader behind, and the process crashes on exit (docs/dds.md).
-  eprosima::fastrtps::LibrarySettingsAttributes lib = eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings();
+  eprosima::fastrtps::LibrarySettingsAttributes lib =
+      eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings();
   lib.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
   eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(lib);
   loaded = file;
@@ -97,7 +102,9 @@ Locator_t udp_locator(const std::string& ip, uint32_t port) {
 /// (docs/security.md). Fast DDS wants absolute file:// URIs.
 void add_security(const DdsConfig& cfg, fdds::DomainParticipantQos& qos) {
   const auto f = cfg.security_files();
-  auto uri = [](const std::string& p) { return "file://" + std::filesystem::absolute(p).lexically_normal().string(); };
+  auto uri = [](const std::string& p) {
+    return "file://" + std::filesystem::absolute(p).lexically_normal().string();
+  };
   auto& props = qos.properties().properties();
   props.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
   props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", uri(f[0]));
@@ -191,7 +198,8 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
     case Discovery::kDiscoveryServer: {
       auto colon = cfg.discovery_server.find(':');
       std::string ip = cfg.discovery_server.substr(0, colon);
-      uint32_t port = colon == std::string::npos ? 11811 : std::stoul(cfg.discovery_server.substr(colon + 1));
+      uint32_t port =
+          colon == std::string::npos ? 11811 : std::stoul(cfg.discovery_server.substr(colon + 1));
       // Reach a server on another host through this host's own address on
       // that network (the whitelist takes local addresses only).
       if (!cfg.interface_ip.empty()) udp->interfaceWhiteList.emplace_back(cfg.interface_ip);
@@ -280,8 +288,8 @@ void handler_threw(fdds::DataReader* r, const std::exception& e) {
 
 std::uint64_t handler_throws() { return g_handler_throws.load(); }
 
-eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
-                                                          std::uint32_t n) {
+eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(
+    const eprosima::fastrtps::rtps::GuidPrefix_t& first, std::uint32_t n) {
   auto p = first;
   p.value[9] = static_cast<eprosima::fastrtps::rtps::octet>(n & 0xff);
   p.value[10] = static_cast<eprosima::fastrtps::rtps::octet>((n >> 8) & 0xff);
@@ -376,7 +384,8 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
                                                fdds::StatusMask::none());
     if (!participant_ && clear_id && qos.wire_protocol().participant_id >= 0) {
-      qos.wire_protocol().participant_id = -1;  // e.g. the id is this process's already: Fast DDS picks
+      qos.wire_protocol().participant_id =
+          -1;  // e.g. the id is this process's already: Fast DDS picks
       participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
                                                  fdds::StatusMask::none());
     }
@@ -386,10 +395,11 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     }
   }
   if (!participant_)
-    throw DdsError("cannot create DDS participant on domain " + std::to_string(cfg.domain_id) +
-                   (secure_ ? " with DDS Security as " + role_ + " (credentials in " + cfg.security_dir +
-                                  ": are they from one scripts/make-certs run, valid, for this domain?)"
-                            : std::string()));
+    throw DdsError(
+        "cannot create DDS participant on domain " + std::to_string(cfg.domain_id) +
+        (secure_ ? " with DDS Security as " + role_ + " (credentials in " + cfg.security_dir +
+                       ": are they from one scripts/make-certs run, valid, for this domain?)"
+                 : std::string()));
   publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
   if (!publisher_ || !subscriber_) {
@@ -469,7 +479,8 @@ void Participant::delete_reader(fdds::DataReader* r) {
 std::string Participant::refused_hint(const std::string& partition) const {
   if (!secure_) return "";
   return " (DDS Security: does role " + role_ + "'s grant allow it" +
-         (partition.empty() ? std::string() : " in partition " + partition) + "? see docs/security.md)";
+         (partition.empty() ? std::string() : " in partition " + partition) +
+         "? see docs/security.md)";
 }
 
 void Participant::close() {

@@ -137,7 +137,8 @@ class Reader : public fdds::DataReaderListener {
       }
     }
   }
-  void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {
+  void on_subscription_matched(fdds::DataReader*,
+                               const fdds::SubscriptionMatchedStatus& s) override {
     if (s.current_count > 0 && matched_.load() == 0) matched_since_ = wall_seconds();
     matched_ = s.current_count;
   }
@@ -156,8 +157,8 @@ class Reader : public fdds::DataReaderListener {
 /// the last three bytes, where Fast DDS's prefixes hold zeros (the
 /// participant id's upper bytes), so it is unique in the process and on the
 /// host, and Fast DDS still sees one host and one process.
-eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(const eprosima::fastrtps::rtps::GuidPrefix_t& first,
-                                                          std::uint32_t n);
+eprosima::fastrtps::rtps::GuidPrefix_t incarnation_prefix(
+    const eprosima::fastrtps::rtps::GuidPrefix_t& first, std::uint32_t n);
 
 /// Whether a process on this host holds the metatraffic port of
 /// participant_id in domain_id on 127.0.0.1, as a live participant with that
@@ -206,7 +207,9 @@ class Participant {
       if (!shared_memory_) q.data_sharing().off();
       w = pub->create_datawriter(topic, q);
     }
-    if (!w) throw DdsError(std::string("cannot create writer for ") + Topic<T>::name + refused_hint(partition));
+    if (!w)
+      throw DdsError(std::string("cannot create writer for ") + Topic<T>::name +
+                     refused_hint(partition));
     return Writer<T>(w);
   }
 
@@ -214,11 +217,14 @@ class Participant {
   /// partition may be a pattern ("drone/*"); by default a per-drone topic
   /// (kPerDronePartition) is read from every drone's partition when secure.
   template <class T>
-  Reader<T>& reader(SampleHandler<T> handler, std::optional<std::string> partition_opt = std::nullopt,
+  Reader<T>& reader(SampleHandler<T> handler,
+                    std::optional<std::string> partition_opt = std::nullopt,
                     Delivery delivery = Delivery::kProfile) {
     if (delivery == Delivery::kLatest && !kPerTickStream<T>)
-      throw DdsError(std::string("only the per-tick streams may be read best-effort, not ") + Topic<T>::name);
-    const std::string partition = partition_opt.value_or(secure_ && kPerDronePartition<T> ? "drone/*" : "");
+      throw DdsError(std::string("only the per-tick streams may be read best-effort, not ") +
+                     Topic<T>::name);
+    const std::string partition =
+        partition_opt.value_or(secure_ && kPerDronePartition<T> ? "drone/*" : "");
     auto* topic = topic_for<T>();
     auto listener = std::make_unique<Reader<T>>(std::move(handler));
     auto* sub = subscriber_for(partition);
@@ -238,7 +244,9 @@ class Participant {
       if (q.data_sharing().kind() != fdds::OFF && bounded(topic)) sub = own_subscriber(partition);
       r = sub->create_datareader(topic, q, listener.get());
     }
-    if (!r) throw DdsError(std::string("cannot create reader for ") + Topic<T>::name + refused_hint(partition));
+    if (!r)
+      throw DdsError(std::string("cannot create reader for ") + Topic<T>::name +
+                     refused_hint(partition));
     listener->attach(r);
     auto& ref = *listener;
     listeners_.push_back(std::move(listener));
@@ -315,7 +323,8 @@ class Participant {
     if (ts.register_type(participant_) != ReturnCode_t::RETCODE_OK &&
         !participant_->find_type(ts.get_type_name()))
       throw DdsError(std::string("cannot register type for ") + Topic<T>::name);
-    auto* t = participant_->create_topic(Topic<T>::name, ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+    auto* t =
+        participant_->create_topic(Topic<T>::name, ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
     if (!t) throw DdsError(std::string("cannot create topic ") + Topic<T>::name);
     topics_[Topic<T>::name] = t;
     return t;

@@ -12,8 +12,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <string>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -65,13 +65,15 @@ TEST(Participant, FastDdsOwnLogIsSilentUnlessAsked) {
   testing::internal::CaptureStderr();
   EPROSIMA_LOG_ERROR(DDSWARM_TEST, "an error Fast DDS would print");
   eprosima::fastdds::dds::Log::Flush();
-  const std::string out = testing::internal::GetCapturedStdout() + testing::internal::GetCapturedStderr();
+  const std::string out =
+      testing::internal::GetCapturedStdout() + testing::internal::GetCapturedStderr();
   EXPECT_EQ(out.find("an error Fast DDS would print") != std::string::npos, asked) << out;
 }
 
 TEST(Participant, IncarnationPrefixKeepsHostAndProcess) {
   eprosima::fastrtps::rtps::GuidPrefix_t first;
-  for (int i = 0; i < 12; ++i) first.value[i] = static_cast<eprosima::fastrtps::rtps::octet>(i < 9 ? 0x10 + i : 0);
+  for (int i = 0; i < 12; ++i)
+    first.value[i] = static_cast<eprosima::fastrtps::rtps::octet>(i < 9 ? 0x10 + i : 0);
   const auto p = incarnation_prefix(first, 0x030201);
   EXPECT_TRUE(std::equal(first.value, first.value + 9, p.value));
   EXPECT_EQ(p.value[9], 0x01);
@@ -105,8 +107,9 @@ TEST(Participant, ReliableWriterServesBestEffortAndReliableReaders) {
   Participant agent(cfg, "participant_test best-effort reader");
   Participant recorder(cfg, "participant_test reliable reader");
   auto w = server.writer<msg::SwarmState>();
-  auto& latest = agent.reader<msg::SwarmState>([&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_latest; },
-                                               std::nullopt, Delivery::kLatest);
+  auto& latest = agent.reader<msg::SwarmState>(
+      [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_latest; }, std::nullopt,
+      Delivery::kLatest);
   auto& all = recorder.reader<msg::SwarmState>(
       [&](const msg::SwarmState&, const fdds::SampleInfo&) { ++got_all; }, std::nullopt,
       Delivery::kArchive);
@@ -114,7 +117,8 @@ TEST(Participant, ReliableWriterServesBestEffortAndReliableReaders) {
   EXPECT_EQ(all.raw()->get_qos().reliability().kind, fdds::RELIABLE_RELIABILITY_QOS);
   EXPECT_EQ(w.raw()->get_qos().reliability().kind, fdds::RELIABLE_RELIABILITY_QOS);
   // Matched both ways: a reader drops what comes before it has matched the writer.
-  ASSERT_TRUE(within(10, [&] { return w.matched() == 2 && latest.matched() == 1 && all.matched() == 1; }))
+  ASSERT_TRUE(
+      within(10, [&] { return w.matched() == 2 && latest.matched() == 1 && all.matched() == 1; }))
       << "the writer matched " << w.matched() << " of 2 readers";
   msg::SwarmState s;
   for (std::uint64_t k = 1; k <= 20; ++k) {
@@ -122,8 +126,10 @@ TEST(Participant, ReliableWriterServesBestEffortAndReliableReaders) {
     ASSERT_TRUE(w.write(s));
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  EXPECT_TRUE(within(10, [&] { return got_all.load() == 20; })) << "the reliable reader got " << got_all.load();
-  EXPECT_TRUE(within(10, [&] { return got_latest.load() > 0; })) << "the best-effort reader got nothing";
+  EXPECT_TRUE(within(10, [&] { return got_all.load() == 20; }))
+      << "the reliable reader got " << got_all.load();
+  EXPECT_TRUE(within(10, [&] { return got_latest.load() > 0; }))
+      << "the best-effort reader got nothing";
   server.close();
   agent.close();
   recorder.close();
@@ -213,7 +219,8 @@ TEST(Participant, ArchiveReaderKeepsEverySampleThroughAStall) {
       std::nullopt, Delivery::kArchive);
   auto& profile = tools.reader<msg::SwarmState>(
       [&](const msg::SwarmState&, const fdds::SampleInfo&) { stall(++got_profile); });
-  ASSERT_TRUE(within(10, [&] { return w.matched() == 2 && archive.matched() == 1 && profile.matched() == 1; }));
+  ASSERT_TRUE(within(
+      10, [&] { return w.matched() == 2 && archive.matched() == 1 && profile.matched() == 1; }));
   msg::SwarmState s;
   for (std::uint64_t k = 1; k <= kSamples; ++k) {
     s.tick(k);
@@ -225,8 +232,8 @@ TEST(Participant, ArchiveReaderKeepsEverySampleThroughAStall) {
   EXPECT_EQ(out_of_order.load(), 0);
   // The data-sharing reader of the same writer misses most of them (and
   // Fast DDS 2.9.1 mostly does not say so): why the recorder reads kArchive.
-  std::printf("stalled 300 ms: archive reader %d of %d, data-sharing reader %d\n", got_archive.load(), kSamples,
-              got_profile.load());
+  std::printf("stalled 300 ms: archive reader %d of %d, data-sharing reader %d\n",
+              got_archive.load(), kSamples, got_profile.load());
   server.close();
   tools.close();
 }
@@ -335,10 +342,12 @@ TEST(Participant, OnlyPerTickStreamsMayBeReadBestEffort) {
   DdsConfig cfg;
   cfg.domain_id = random_test_domain();
   Participant p(cfg, "participant_test");
-  EXPECT_THROW(p.reader<msg::Scene>([](const msg::Scene&, const fdds::SampleInfo&) {}, std::nullopt, Delivery::kLatest),
+  EXPECT_THROW(p.reader<msg::Scene>([](const msg::Scene&, const fdds::SampleInfo&) {}, std::nullopt,
+                                    Delivery::kLatest),
                DdsError);
-  EXPECT_NO_THROW(p.reader<msg::VelocityCommand>([](const msg::VelocityCommand&, const fdds::SampleInfo&) {},
-                                                 std::nullopt, Delivery::kLatest));
+  EXPECT_NO_THROW(
+      p.reader<msg::VelocityCommand>([](const msg::VelocityCommand&, const fdds::SampleInfo&) {},
+                                     std::nullopt, Delivery::kLatest));
 }
 
 // The whole-swarm state goes by data-sharing, a pool in /dev/shm, to readers

@@ -302,7 +302,8 @@ double wall_seconds() {
 
 std::uint64_t random_instance() {
   std::random_device rd;
-  std::uint64_t v = (static_cast<std::uint64_t>(rd()) << 32 | rd()) ^ static_cast<std::uint64_t>(getpid());
+  std::uint64_t v =
+      (static_cast<std::uint64_t>(rd()) << 32 | rd()) ^ static_cast<std::uint64_t>(getpid());
   return v ? v : 1;
 }
 

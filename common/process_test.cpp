@@ -76,7 +76,9 @@ double sleep_until_stopped(std::mutex& mu, std::condition_variable& cv) {
 [[noreturn]] void only_living_wakers_called() {
   int gone_calls = 0;
   int living_calls = 0;
-  { const StopWaker gone([&] { ++gone_calls; }); }
+  {
+    const StopWaker gone([&] { ++gone_calls; });
+  }
   std::optional<StopWaker> living;
   living.emplace([&] { ++living_calls; });
   request_stop();

@@ -18,10 +18,9 @@ void ScenarioConfig::validate() const {
 }
 
 void check_sections(const YamlDocument& doc) {
-  static const std::set<std::string> known = {"scenario", "sim",    "quadrotor",      "controller",
-                                              "sensors",  "scene",  "agent",          "comm",
-                                              "dds",      "ground_station", "task",
-                                              "wind",     "aero"};
+  static const std::set<std::string> known = {
+      "scenario", "sim", "quadrotor",      "controller", "sensors", "scene", "agent",
+      "comm",     "dds", "ground_station", "task",       "wind",    "aero"};
   const auto& root = doc.root();
   if (!root || !root.IsMap()) return;
   for (auto it = root.begin(); it != root.end(); ++it) {

@@ -20,11 +20,13 @@ struct ScenarioConfig {
   /// Every field once (common/config_fields.hpp).
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    static const Choices<TimeMode> kModes{{"realtime", TimeMode::kRealtime}, {"lockstep", TimeMode::kLockstep}};
+    static const Choices<TimeMode> kModes{{"realtime", TimeMode::kRealtime},
+                                          {"lockstep", TimeMode::kLockstep}};
     v.field("name", c.name, {"", any(), "shown in logs and results"});
     v.field("seed", c.seed, {"", any(), "seeds sensor noise, random starts, comm models and laws"});
     v.field("drones", c.drones, {"", in(1, 1024), "number of drones, ids 0..drones-1"});
-    v.choice("mode", c.mode, kModes, {"", any(), "realtime: wall-clock paced; lockstep: waits for every agent"});
+    v.choice("mode", c.mode, kModes,
+             {"", any(), "realtime: wall-clock paced; lockstep: waits for every agent"});
   }
 
   void validate() const;

@@ -37,7 +37,8 @@ void SceneConfig::validate() const {
   Eigen::Vector2d d = finish_b - finish_a;
   Eigen::Vector2d g = goal_xy - finish_a;
   if (std::abs(d.x() * g.y() - d.y() * g.x()) < 1e-9)
-    throw FieldError("scene.goal_xy", to_text(goal_xy.transpose()), "must not lie on the finish line");
+    throw FieldError("scene.goal_xy", to_text(goal_xy.transpose()),
+                     "must not lie on the finish line");
 }
 
 Eigen::Vector2d SceneConfig::task_direction() const {
@@ -105,7 +106,8 @@ std::vector<Eigen::Vector3d> SceneConfig::start_positions(int n, std::uint64_t s
       if (std::abs(a.norm() - b.norm()) > 1e-9) return a.norm() < b.norm();
       return std::atan2(a.y(), a.x()) < std::atan2(b.y(), b.x());
     });
-    for (int i = 0; i < n; ++i) out.emplace_back(s.center_xy.x() + pts[i].x(), s.center_xy.y() + pts[i].y(), z);
+    for (int i = 0; i < n; ++i)
+      out.emplace_back(s.center_xy.x() + pts[i].x(), s.center_xy.y() + pts[i].y(), z);
   } else {
     std::mt19937_64 rng(seed ^ 0x5ca77e7ULL);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -125,8 +127,9 @@ std::vector<Eigen::Vector3d> SceneConfig::start_positions(int n, std::uint64_t s
   }
   for (int i = 0; i < n; ++i) {
     if (clearance(out[i] + Eigen::Vector3d(0, 0, 0.1)) < 0.5)
-      throw FieldError("scene.start", "drone " + std::to_string(i) + " at (" +
-                                          to_text(out[i].x()) + ", " + to_text(out[i].y()) + ")",
+      throw FieldError("scene.start",
+                       "drone " + std::to_string(i) + " at (" + to_text(out[i].x()) + ", " +
+                           to_text(out[i].y()) + ")",
                        "start position is inside or next to an obstacle");
   }
   return out;

@@ -37,7 +37,8 @@ struct Box {
 
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    v.field("center", c.center, {"m", any(), "centre (absolute: a box on the ground has z = size.z / 2)"});
+    v.field("center", c.center,
+            {"m", any(), "centre (absolute: a box on the ground has z = size.z / 2)"});
     v.field("size", c.size, {"m", any(), "full extents along the box's own axes"});
     v.field("yaw_rad", c.yaw_rad, {"rad", any(), "rotation about +z"});
   }
@@ -50,11 +51,11 @@ enum class Formation { kCluster, kGrid, kRandom, kExplicit };
 /// minimum spacing; kExplicit uses positions as listed.
 struct StartConfig {
   Formation formation = Formation::kCluster;
-  Eigen::Vector2d center_xy{0, 0};           ///< m
-  double spacing_m = 2.0;                    ///< m between neighbours, >= 0.7
-  double radius_m = 8.0;                     ///< m, disc radius for kRandom
-  double yaw_rad = 0.0;                      ///< initial heading of every drone
-  std::vector<Eigen::Vector3d> positions;    ///< kExplicit: one per drone (z = 0 on ground)
+  Eigen::Vector2d center_xy{0, 0};         ///< m
+  double spacing_m = 2.0;                  ///< m between neighbours, >= 0.7
+  double radius_m = 8.0;                   ///< m, disc radius for kRandom
+  double yaw_rad = 0.0;                    ///< initial heading of every drone
+  std::vector<Eigen::Vector3d> positions;  ///< kExplicit: one per drone (z = 0 on ground)
 };
 
 /// The control rates a server flies (sim.control_rate_hz), and an agent
@@ -86,15 +87,19 @@ struct SceneConfig {
     v.field("ground_z_m", c.ground_z_m, {"m", any(), "height of the ground plane"});
     v.list("cylinders", c.cylinders, "vertical pillars standing on the ground");
     v.list("boxes", c.boxes, "boxes");
-    v.field("bounds_min", c.bounds_min, {"m", any(), "world bounds: leaving them is flagged, not prevented"});
-    v.field("bounds_max", c.bounds_max, {"m", any(), "world bounds; above bounds_min and the ground"});
+    v.field("bounds_min", c.bounds_min,
+            {"m", any(), "world bounds: leaving them is flagged, not prevented"});
+    v.field("bounds_max", c.bounds_max,
+            {"m", any(), "world bounds; above bounds_min and the ground"});
     v.section("finish_line", [&](auto& w) {
       w.field("a", c.finish_a, {"m", any(), "one end of the finish line"});
       w.field("b", c.finish_b, {"m", any(), "other end; != a"});
     });
-    v.field("goal_xy", c.goal_xy, {"m", any(), "the point the task flies toward and gathers around"});
+    v.field("goal_xy", c.goal_xy,
+            {"m", any(), "the point the task flies toward and gathers around"});
     v.section("start", [&](auto& w) {
-      w.choice("formation", c.start.formation, kFormations, {"", any(), "how start positions are made"});
+      w.choice("formation", c.start.formation, kFormations,
+               {"", any(), "how start positions are made"});
       w.field("center_xy", c.start.center_xy, {"m", any(), "centre of the formation"});
       w.field("spacing_m", c.start.spacing_m, {"m", any(), "distance between neighbours; >= 0.7"});
       w.field("radius_m", c.start.radius_m, {"m", positive(), "disc radius for random"});

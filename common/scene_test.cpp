@@ -49,7 +49,8 @@ TEST(Scene, StartInsideObstacleIsRejected) {
 TEST(Reference, TheScenarioAndSceneSectionsDescribeEveryFieldAsTheCodeDeclaresIt) {
   const std::string doc = configuration_reference();
   using Mismatches = std::vector<std::string>;
-  EXPECT_EQ(reference_mismatches(doc, "### `scenario:`", field_rows<ScenarioConfig>()), Mismatches{});
+  EXPECT_EQ(reference_mismatches(doc, "### `scenario:`", field_rows<ScenarioConfig>()),
+            Mismatches{});
   std::vector<FieldRow> scene;  // scene.generate has its own table (world_gen_test)
   for (const auto& r : field_rows<SceneConfig>())
     if (r.key.rfind("generate.", 0) != 0) scene.push_back(r);

@@ -49,18 +49,18 @@ class SafePubSub : public Generated {
 /// The swarm state, which every agent reads every tick, decodes inline
 /// (decode_swarm_state in common/swarm_state_cdr.hpp), to the same sample.
 template <>
-bool SafePubSub<msg::SwarmStatePubSubType>::deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload,
-                                                        void* data);
+bool SafePubSub<msg::SwarmStatePubSubType>::deserialize(
+    eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data);
 
 template <class T>
 struct Topic;
 
-#define DDSWARM_TOPIC(Type, topic_name, qos_profile)            \
-  template <>                                                    \
-  struct Topic<msg::Type> {                                      \
-    using PubSub = SafePubSub<msg::Type##PubSubType>;            \
-    static constexpr const char* name = topic_name;              \
-    static constexpr const char* profile = qos_profile;          \
+#define DDSWARM_TOPIC(Type, topic_name, qos_profile)    \
+  template <>                                           \
+  struct Topic<msg::Type> {                             \
+    using PubSub = SafePubSub<msg::Type##PubSubType>;   \
+    static constexpr const char* name = topic_name;     \
+    static constexpr const char* profile = qos_profile; \
   }
 
 DDSWARM_TOPIC(SwarmState, "ddswarm/swarm_state", "state");

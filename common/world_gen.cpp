@@ -1,8 +1,8 @@
 #include "common/world_gen.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 #include <unordered_map>
 #include <vector>
 
@@ -18,14 +18,18 @@ constexpr double kPi = 3.14159265358979323846;
 /// implementation-defined).
 class Draw {
  public:
-  Draw(std::uint64_t seed, std::uint64_t salt) : s_(seed ^ (salt * 0x9e3779b97f4a7c15ULL)) { next(); }
+  Draw(std::uint64_t seed, std::uint64_t salt) : s_(seed ^ (salt * 0x9e3779b97f4a7c15ULL)) {
+    next();
+  }
   std::uint64_t next() {
     std::uint64_t z = (s_ += 0x9e3779b97f4a7c15ULL);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return z ^ (z >> 31);
   }
-  double uniform(double lo, double hi) { return lo + (hi - lo) * (static_cast<double>(next() >> 11) * 0x1.0p-53); }
+  double uniform(double lo, double hi) {
+    return lo + (hi - lo) * (static_cast<double>(next() >> 11) * 0x1.0p-53);
+  }
 
  private:
   std::uint64_t s_;
@@ -40,8 +44,8 @@ struct Course {
 };
 
 /// A wall as a box from a to b (xy, the wall's own axis), z from z0 to z1 above the ground.
-Box wall_box(const SceneConfig& scene, const Eigen::Vector2d& a, const Eigen::Vector2d& b, double thickness,
-             double z0, double z1) {
+Box wall_box(const SceneConfig& scene, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+             double thickness, double z0, double z1) {
   const Eigen::Vector2d mid = 0.5 * (a + b), d = b - a;
   Box box;
   box.center = Eigen::Vector3d(mid.x(), mid.y(), scene.ground_z_m + 0.5 * (z0 + z1));
@@ -56,7 +60,8 @@ bool kept_out(const SceneConfig& scene, const Eigen::Vector2d& p, double r) {
 
 void check_ordered(const std::string& field, const Eigen::Vector2d& v) {
   if (!(v.x() > 0 && v.y() >= v.x()))
-    throw FieldError(field, "[" + to_text(v.x()) + ", " + to_text(v.y()) + "]", "must be [min, max] with 0 < min <= max");
+    throw FieldError(field, "[" + to_text(v.x()) + ", " + to_text(v.y()) + "]",
+                     "must be [min, max] with 0 < min <= max");
 }
 
 void check_area(const std::string& prefix, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
@@ -68,9 +73,12 @@ void check_area(const std::string& prefix, const Eigen::Vector2d& lo, const Eige
 int urban(const UrbanConfig& u, Draw& d, SceneConfig& scene) {
   const double pitch = u.block_m + u.street_m;
   int made = 0;
-  for (double x = u.area_min.x() + 0.5 * u.street_m; x + u.block_m <= u.area_max.x() + 1e-9; x += pitch)
-    for (double y = u.area_min.y() + 0.5 * u.street_m; y + u.block_m <= u.area_max.y() + 1e-9; y += pitch) {
-      const double sx = u.block_m * d.uniform(u.fill_min, 1.0), sy = u.block_m * d.uniform(u.fill_min, 1.0);
+  for (double x = u.area_min.x() + 0.5 * u.street_m; x + u.block_m <= u.area_max.x() + 1e-9;
+       x += pitch)
+    for (double y = u.area_min.y() + 0.5 * u.street_m; y + u.block_m <= u.area_max.y() + 1e-9;
+         y += pitch) {
+      const double sx = u.block_m * d.uniform(u.fill_min, 1.0),
+                   sy = u.block_m * d.uniform(u.fill_min, 1.0);
       const double h = d.uniform(u.height_m.x(), u.height_m.y());
       const Eigen::Vector2d c(x + 0.5 * u.block_m + d.uniform(-0.5, 0.5) * (u.block_m - sx),
                               y + 0.5 * u.block_m + d.uniform(-0.5, 0.5) * (u.block_m - sy));
@@ -101,7 +109,8 @@ int walls(const WallsConfig& w, Draw& d, SceneConfig& scene) {
     std::sort(centres.begin(), centres.end());
     auto add = [&](double t0, double t1, double z0, double z1) {
       if (t1 - t0 < 1e-6 || z1 - z0 < 1e-6) return;
-      scene.boxes.push_back(wall_box(scene, course.at(s, t0), course.at(s, t1), w.thickness_m, z0, z1));
+      scene.boxes.push_back(
+          wall_box(scene, course.at(s, t0), course.at(s, t1), w.thickness_m, z0, z1));
       ++made;
     };
     double from = -half;
@@ -151,8 +160,8 @@ int corridor(const CorridorConfig& c, Draw& d, SceneConfig& scene) {
       const Eigen::Vector2d dir = (line[k + 1] - line[k]).normalized();
       const double grow = 0.5 * c.thickness_m;
       scene.boxes.push_back(wall_box(scene, line[k] - (k > 0 ? grow : 0.0) * dir,
-                                     line[k + 1] + (k + 1 < legs ? grow : 0.0) * dir, c.thickness_m, 0,
-                                     c.wall_height_m));
+                                     line[k + 1] + (k + 1 < legs ? grow : 0.0) * dir, c.thickness_m,
+                                     0, c.wall_height_m));
       ++made;
     }
   }
@@ -185,7 +194,8 @@ int forest(const ForestConfig& f, Draw& d, SceneConfig& scene, int* wanted) {
     Cylinder c;
     c.radius_m = d.uniform(f.radius_m.x(), f.radius_m.y());
     c.height_m = d.uniform(f.height_m.x(), f.height_m.y());
-    c.center_xy = Eigen::Vector2d(d.uniform(f.area_min.x(), f.area_max.x()), d.uniform(f.area_min.y(), f.area_max.y()));
+    c.center_xy = Eigen::Vector2d(d.uniform(f.area_min.x(), f.area_max.x()),
+                                  d.uniform(f.area_min.y(), f.area_max.y()));
     if (kept_out(scene, c.center_xy, f.keep_out_m + c.radius_m)) continue;
     const Eigen::Vector3d at(c.center_xy.x(), c.center_xy.y(), scene.ground_z_m + 0.5);
     if (!before.cylinders.empty() || !before.boxes.empty())
@@ -222,19 +232,22 @@ void WorldGenConfig::validate() const {
   if (walls.count > 0) {
     if (walls.openings * (walls.opening_width_m + walls.thickness_m) > walls.length_m)
       throw FieldError(p + ".walls.opening_width_m", to_text(walls.opening_width_m),
-                       fmt::format("{} openings this wide do not fit in a wall {} m long", walls.openings,
-                                   to_text(walls.length_m)));
-    if (walls.window_height_m > 0 && walls.window_bottom_m + walls.window_height_m >= walls.height_m)
-      throw FieldError(p + ".walls.window_height_m", to_text(walls.window_height_m),
-                       fmt::format("a window from {} m up this tall does not fit in a wall {} m high",
-                                   to_text(walls.window_bottom_m), to_text(walls.height_m)));
+                       fmt::format("{} openings this wide do not fit in a wall {} m long",
+                                   walls.openings, to_text(walls.length_m)));
+    if (walls.window_height_m > 0 &&
+        walls.window_bottom_m + walls.window_height_m >= walls.height_m)
+      throw FieldError(
+          p + ".walls.window_height_m", to_text(walls.window_height_m),
+          fmt::format("a window from {} m up this tall does not fit in a wall {} m high",
+                      to_text(walls.window_bottom_m), to_text(walls.height_m)));
   }
   if (urban.block_m > 0) {
     check_ordered(p + ".urban.height_m", urban.height_m);
     check_area(p + ".urban", urban.area_min, urban.area_max);
     if (urban.area_max.x() - urban.area_min.x() < urban.block_m + urban.street_m ||
         urban.area_max.y() - urban.area_min.y() < urban.block_m + urban.street_m)
-      throw FieldError(p + ".urban.block_m", to_text(urban.block_m), "no block and street fit in the area");
+      throw FieldError(p + ".urban.block_m", to_text(urban.block_m),
+                       "no block and street fit in the area");
   }
 }
 
@@ -243,13 +256,15 @@ std::string WorldGenReport::summary() const {
   if (buildings) parts.push_back(fmt::format("{} buildings", buildings));
   if (wall_boxes) parts.push_back(fmt::format("walls of {} boxes", wall_boxes));
   if (corridor_boxes) parts.push_back(fmt::format("a corridor of {} boxes", corridor_boxes));
-  if (pillars_wanted) parts.push_back(fmt::format("a forest of {} pillars (of {} wanted)", pillars, pillars_wanted));
+  if (pillars_wanted)
+    parts.push_back(fmt::format("a forest of {} pillars (of {} wanted)", pillars, pillars_wanted));
   std::string s;
   for (const auto& x : parts) s += (s.empty() ? "" : ", ") + x;
   return s.empty() ? "nothing" : s;
 }
 
-WorldGenReport generate_world(const WorldGenConfig& g, std::uint64_t scenario_seed, SceneConfig& scene) {
+WorldGenReport generate_world(const WorldGenConfig& g, std::uint64_t scenario_seed,
+                              SceneConfig& scene) {
   const std::uint64_t seed = g.seed ? g.seed : scenario_seed;
   WorldGenReport r;
   // One stream per kind: adding walls leaves the forest's draws as they were.

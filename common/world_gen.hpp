@@ -31,13 +31,17 @@ struct ForestConfig {
 
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    v.field("density_per_100m2", c.density_per_100m2, {"1/(100 m²)", non_negative(), "pillars per 100 m²; 0 = none"});
+    v.field("density_per_100m2", c.density_per_100m2,
+            {"1/(100 m²)", non_negative(), "pillars per 100 m²; 0 = none"});
     v.field("radius_m", c.radius_m, {"m", any(), "[min, max] radius, 0 < min <= max"});
     v.field("height_m", c.height_m, {"m", any(), "[min, max] height, 0 < min <= max"});
     v.field("area_min", c.area_min, {"m", any(), "the forest's corner (xy)"});
-    v.field("area_max", c.area_max, {"m", any(), "the opposite corner, above area_min on both axes"});
-    v.field("min_gap_m", c.min_gap_m, {"m", non_negative(), "free space between two pillars at least"});
-    v.field("keep_out_m", c.keep_out_m, {"m", non_negative(), "no pillar this close to the start centre or the goal"});
+    v.field("area_max", c.area_max,
+            {"m", any(), "the opposite corner, above area_min on both axes"});
+    v.field("min_gap_m", c.min_gap_m,
+            {"m", non_negative(), "free space between two pillars at least"});
+    v.field("keep_out_m", c.keep_out_m,
+            {"m", non_negative(), "no pillar this close to the start centre or the goal"});
   }
 };
 
@@ -56,16 +60,20 @@ struct WallsConfig {
   template <class Self, class V>
   static void fields(Self& c, V& v) {
     v.field("count", c.count, {"", in(0, 100), "walls across the course; 0 = none"});
-    v.field("first_at_m", c.first_at_m, {"m", positive(), "the first wall's distance from the start centre along the course"});
+    v.field("first_at_m", c.first_at_m,
+            {"m", positive(), "the first wall's distance from the start centre along the course"});
     v.field("spacing_m", c.spacing_m, {"m", positive(), "between two walls along the course"});
-    v.field("length_m", c.length_m, {"m", positive(), "each wall's length, centred on the course's axis"});
+    v.field("length_m", c.length_m,
+            {"m", positive(), "each wall's length, centred on the course's axis"});
     v.field("height_m", c.height_m, {"m", positive(), "each wall's height"});
     v.field("thickness_m", c.thickness_m, {"m", positive(), "each wall's thickness"});
     v.field("openings", c.openings, {"", in(1, 20), "openings per wall, at seeded places"});
     v.field("opening_width_m", c.opening_width_m, {"m", positive(), "each opening's width"});
     v.field("window_height_m", c.window_height_m,
-            {"m", non_negative(), "0: the openings are gaps from the ground up; else windows this tall"});
-    v.field("window_bottom_m", c.window_bottom_m, {"m", non_negative(), "a window's sill above the ground"});
+            {"m", non_negative(),
+             "0: the openings are gaps from the ground up; else windows this tall"});
+    v.field("window_bottom_m", c.window_bottom_m,
+            {"m", non_negative(), "a window's sill above the ground"});
   }
 };
 
@@ -80,8 +88,10 @@ struct CorridorConfig {
 
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    v.field("length_m", c.length_m, {"m", non_negative(), "the corridor's length along the course; 0 = none"});
-    v.field("start_at_m", c.start_at_m, {"m", non_negative(), "its entrance's distance from the start centre"});
+    v.field("length_m", c.length_m,
+            {"m", non_negative(), "the corridor's length along the course; 0 = none"});
+    v.field("start_at_m", c.start_at_m,
+            {"m", non_negative(), "its entrance's distance from the start centre"});
     v.field("width_m", c.width_m, {"m", positive(), "free width between its walls"});
     v.field("bends", c.bends, {"", in(0, 20), "turns, alternating left and right"});
     v.field("bend_deg", c.bend_deg, {"deg", in(0, 60), "each leg's angle to the course's axis"});
@@ -103,11 +113,14 @@ struct UrbanConfig {
   static void fields(Self& c, V& v) {
     v.field("block_m", c.block_m, {"m", non_negative(), "a block's side; 0 = none"});
     v.field("street_m", c.street_m, {"m", positive(), "a street's width"});
-    v.field("fill_min", c.fill_min, {"", in(0.05, 1), "a building's footprint side is [fill_min, 1] of the block's"});
+    v.field("fill_min", c.fill_min,
+            {"", in(0.05, 1), "a building's footprint side is [fill_min, 1] of the block's"});
     v.field("height_m", c.height_m, {"m", any(), "[min, max] building height, 0 < min <= max"});
     v.field("area_min", c.area_min, {"m", any(), "the city's corner (xy)"});
-    v.field("area_max", c.area_max, {"m", any(), "the opposite corner, above area_min on both axes"});
-    v.field("keep_out_m", c.keep_out_m, {"m", non_negative(), "no building this close to the start centre or the goal"});
+    v.field("area_max", c.area_max,
+            {"m", any(), "the opposite corner, above area_min on both axes"});
+    v.field("keep_out_m", c.keep_out_m,
+            {"m", non_negative(), "no building this close to the start centre or the goal"});
   }
 };
 
@@ -130,7 +143,8 @@ struct WorldGenConfig {
 
   /// True when something is to be generated.
   bool enabled() const {
-    return forest.density_per_100m2 > 0 || walls.count > 0 || corridor.length_m > 0 || urban.block_m > 0;
+    return forest.density_per_100m2 > 0 || walls.count > 0 || corridor.length_m > 0 ||
+           urban.block_m > 0;
   }
   /// Throws FieldError("scene.generate.…") for what the field list cannot
   /// check: ranges whose ends are ordered, openings that fit their wall.
@@ -146,6 +160,7 @@ struct WorldGenReport {
 
 /// Adds the obstacles g describes to scene, drawn from seed (g.seed, or
 /// scenario_seed when it is 0): the same seed gives the same world.
-WorldGenReport generate_world(const WorldGenConfig& g, std::uint64_t scenario_seed, SceneConfig& scene);
+WorldGenReport generate_world(const WorldGenConfig& g, std::uint64_t scenario_seed,
+                              SceneConfig& scene);
 
 }  // namespace ddswarm

@@ -44,7 +44,8 @@ std::string error_of(const std::string& yaml) {
 bool same_world(const SceneConfig& a, const SceneConfig& b) {
   if (a.cylinders.size() != b.cylinders.size() || a.boxes.size() != b.boxes.size()) return false;
   for (std::size_t k = 0; k < a.cylinders.size(); ++k)
-    if (a.cylinders[k].center_xy != b.cylinders[k].center_xy || a.cylinders[k].radius_m != b.cylinders[k].radius_m)
+    if (a.cylinders[k].center_xy != b.cylinders[k].center_xy ||
+        a.cylinders[k].radius_m != b.cylinders[k].radius_m)
       return false;
   for (std::size_t k = 0; k < a.boxes.size(); ++k)
     if (a.boxes[k].center != b.boxes[k].center || a.boxes[k].size != b.boxes[k].size) return false;
@@ -87,7 +88,8 @@ TEST(WorldGen, AForestHasTheDensityAskedForItsSpacingAndItsKeepOuts) {
     EXPECT_GE((a.center_xy - s.goal_xy).norm(), g.forest.keep_out_m + a.radius_m);
     for (std::size_t j = i + 1; j < s.cylinders.size(); ++j) {
       const auto& b = s.cylinders[j];
-      EXPECT_GE((a.center_xy - b.center_xy).norm(), a.radius_m + b.radius_m + g.forest.min_gap_m - 1e-9);
+      EXPECT_GE((a.center_xy - b.center_xy).norm(),
+                a.radius_m + b.radius_m + g.forest.min_gap_m - 1e-9);
     }
   }
   // A full area stops at what fits, and says so.
@@ -107,7 +109,8 @@ TEST(WorldGen, AForestKeepsClearOfTheOtherObstacles) {
   w.walls = g.walls;
   generate_world(w, 7, walls_only);
   for (const auto& c : s.cylinders)
-    EXPECT_GE(walls_only.clearance(Vector3d(c.center_xy.x(), c.center_xy.y(), 0.5)), c.radius_m + g.forest.min_gap_m);
+    EXPECT_GE(walls_only.clearance(Vector3d(c.center_xy.x(), c.center_xy.y(), 0.5)),
+              c.radius_m + g.forest.min_gap_m);
 }
 
 TEST(WorldGen, WallsCrossTheCourseWithTheirGaps) {
@@ -168,7 +171,8 @@ TEST(WorldGen, ACorridorLeavesItsWidthFreeAlongItsCentreLine) {
   // Follow the free channel: at each step along the course, the middle of
   // the free stretch across it is at least width/2 from every wall, and the
   // walls close it in on both sides.
-  for (double y = g.corridor.start_at_m + 2; y < g.corridor.start_at_m + g.corridor.length_m - 2; y += 0.5) {
+  for (double y = g.corridor.start_at_m + 2; y < g.corridor.start_at_m + g.corridor.length_m - 2;
+       y += 0.5) {
     double lo = NAN, hi = NAN;
     for (double x = -20; x <= 20; x += 0.02) {
       const bool free = s.clearance(Vector3d(x, y, 2.0)) > 0;
@@ -202,7 +206,8 @@ TEST(WorldGen, ACityHasItsStreetsFree) {
   // by half a street at least.
   const double pitch = g.urban.block_m + g.urban.street_m;
   int streets = 0;
-  for (double x = g.urban.area_min.x() + 0.5 * g.urban.street_m + g.urban.block_m + 0.5 * g.urban.street_m;
+  for (double x =
+           g.urban.area_min.x() + 0.5 * g.urban.street_m + g.urban.block_m + 0.5 * g.urban.street_m;
        x + 0.5 * g.urban.street_m < g.urban.area_max.x(); x += pitch, ++streets)
     for (double y = 10; y < 60; y += 0.5)
       EXPECT_GE(s.clearance(Vector3d(x, y, 1.0)), 0.5 * g.urban.street_m - 1e-9) << x << " " << y;
@@ -212,17 +217,26 @@ TEST(WorldGen, ACityHasItsStreetsFree) {
 TEST(WorldGen, BadInputNamesFieldAndValue) {
   EXPECT_EQ(error_of("scene:\n  generate:\n    forest:\n      density_per_100m2: -1\n"),
             "w.yaml:4: scene.generate.forest.density_per_100m2 = -1: must be >= 0");
-  EXPECT_EQ(error_of("scene:\n  generate:\n    forest:\n      density_per_100m2: 1\n      radius_m: [0.8, 0.3]\n"),
-            "w.yaml:5: scene.generate.forest.radius_m = [0.8, 0.3]: must be [min, max] with 0 < min <= max");
-  EXPECT_EQ(error_of("scene:\n  generate:\n    walls:\n      count: 2\n      length_m: 10\n      openings: 2\n"
-                     "      opening_width_m: 6\n"),
-            "w.yaml:7: scene.generate.walls.opening_width_m = 6: 2 openings this wide do not fit in a wall 10 m long");
-  EXPECT_EQ(error_of("scene:\n  generate:\n    walls:\n      count: 1\n      window_height_m: 5.5\n"),
-            "w.yaml:5: scene.generate.walls.window_height_m = 5.5: a window from 1 m up this tall does not fit in a "
-            "wall 6 m high");
-  EXPECT_NE(error_of("scene:\n  generate:\n    forests: {}\n").find("forests"), std::string::npos) << "unknown key";
-  EXPECT_EQ(error_of("scene:\n  generate:\n    corridor:\n      length_m: 40\n      bend_deg: 80\n"),
-            "w.yaml:5: scene.generate.corridor.bend_deg = 80: must be in [0, 60]");
+  EXPECT_EQ(error_of("scene:\n  generate:\n    forest:\n      density_per_100m2: 1\n      "
+                     "radius_m: [0.8, 0.3]\n"),
+            "w.yaml:5: scene.generate.forest.radius_m = [0.8, 0.3]: must be [min, max] with 0 < "
+            "min <= max");
+  EXPECT_EQ(
+      error_of(
+          "scene:\n  generate:\n    walls:\n      count: 2\n      length_m: 10\n      openings: 2\n"
+          "      opening_width_m: 6\n"),
+      "w.yaml:7: scene.generate.walls.opening_width_m = 6: 2 openings this wide do not fit in a "
+      "wall 10 m long");
+  EXPECT_EQ(
+      error_of("scene:\n  generate:\n    walls:\n      count: 1\n      window_height_m: 5.5\n"),
+      "w.yaml:5: scene.generate.walls.window_height_m = 5.5: a window from 1 m up this tall does "
+      "not fit in a "
+      "wall 6 m high");
+  EXPECT_NE(error_of("scene:\n  generate:\n    forests: {}\n").find("forests"), std::string::npos)
+      << "unknown key";
+  EXPECT_EQ(
+      error_of("scene:\n  generate:\n    corridor:\n      length_m: 40\n      bend_deg: 80\n"),
+      "w.yaml:5: scene.generate.corridor.bend_deg = 80: must be in [0, 60]");
 }
 
 TEST(WorldGen, TheReferenceDescribesEveryField) {
@@ -230,5 +244,6 @@ TEST(WorldGen, TheReferenceDescribesEveryField) {
   for (const auto& r : field_rows<SceneConfig>())
     if (r.key.rfind("generate.", 0) == 0) rows.push_back(r);
   ASSERT_GT(rows.size(), 20u);
-  EXPECT_EQ(reference_mismatches(configuration_reference(), "(`scene.generate`)", rows), std::vector<std::string>{});
+  EXPECT_EQ(reference_mismatches(configuration_reference(), "(`scene.generate`)", rows),
+            std::vector<std::string>{});
 }

@@ -30,9 +30,7 @@ YamlSection::YamlSection(YAML::Node node, std::string file, std::string path)
   }
 }
 
-bool YamlSection::has(const std::string& key) const {
-  return node_ && node_.IsMap() && node_[key];
-}
+bool YamlSection::has(const std::string& key) const { return node_ && node_.IsMap() && node_[key]; }
 
 YAML::Node YamlSection::take(const std::string& key) {
   consumed_.insert(key);
@@ -107,10 +105,10 @@ T YamlSection::convert(const YAML::Node& n, const std::string& key) const {
       static_assert(sizeof(T) == 0, "unsupported config field type");
     }
   } catch (const YAML::Exception&) {
-    const char* what = std::is_same_v<T, bool>            ? "must be true or false"
-                       : std::is_integral_v<T>            ? "must be an integer"
-                       : std::is_floating_point_v<T>      ? "must be a number"
-                                                          : "has the wrong type";
+    const char* what = std::is_same_v<T, bool>       ? "must be true or false"
+                       : std::is_integral_v<T>       ? "must be an integer"
+                       : std::is_floating_point_v<T> ? "must be a number"
+                                                     : "has the wrong type";
     fail(n, key, scalar_text(n), what);
   }
 }
@@ -193,7 +191,8 @@ YamlDocument YamlDocument::parse(const std::string& text, const std::string& fil
 void YamlDocument::index(const YAML::Node& n, const std::string& prefix, int depth) {
   // An alias that refers to itself makes an endless tree; no config nests this deep.
   if (depth > 32)
-    throw ConfigError(file_ + ":" + std::to_string(n.Mark().line + 1) + ": " + prefix.substr(0, 80) +
+    throw ConfigError(file_ + ":" + std::to_string(n.Mark().line + 1) + ": " +
+                      prefix.substr(0, 80) +
                       "...: nested more than 32 levels (a recursive alias?)");
   if (n.IsMap()) {
     for (auto it = n.begin(); it != n.end(); ++it) {

@@ -39,7 +39,8 @@ TEST(YamlSection, ReadsValuesAndKeepsDefaults) {
 }
 
 TEST(YamlSection, UnknownKeyNamesFileLineAndKey) {
-  EXPECT_EQ(error_of("demo:\n  radius_m: 2\n  colour: red\n"), "x.yaml:3: demo.colour: unknown key");
+  EXPECT_EQ(error_of("demo:\n  radius_m: 2\n  colour: red\n"),
+            "x.yaml:3: demo.colour: unknown key");
 }
 
 TEST(YamlSection, WrongTypeNamesValue) {
@@ -59,7 +60,8 @@ TEST(YamlSection, SyntaxErrorAndMissingFile) {
 
 // Found by fuzz_config: a quoted key holding a newline made a two-line error.
 TEST(YamlSection, ErrorsStayOnOneLineWhateverTheFileHolds) {
-  EXPECT_EQ(error_of("demo:\n  \"rad\\nius\\t\\x01\": 2\n"), "x.yaml:2: demo.rad\\nius\\t\\x01: unknown key");
+  EXPECT_EQ(error_of("demo:\n  \"rad\\nius\\t\\x01\": 2\n"),
+            "x.yaml:2: demo.rad\\nius\\t\\x01: unknown key");
 }
 
 TEST(YamlSection, DuplicateKeyIsAnError) {

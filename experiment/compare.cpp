@@ -208,9 +208,7 @@ std::string comparison_table(const std::vector<SetComparison>& sets, const std::
        << (std::isfinite(c.rank.p)
                ? fmt::format("{:.3g}{}", c.rank.p, c.rank.exact ? " (exact)" : "")
                : "n/a")
-       << " | "
-       << verdict(std::isfinite(c.rank.p), c.rank.p < 0.05)
-       << " | "
+       << " | " << verdict(std::isfinite(c.rank.p), c.rank.p < 0.05) << " | "
        << (c.paired_runs ? fmt::format("{:.2f} ({:.2f}) s, {} runs", c.paired_mean_abs_s,
                                        c.paired_max_abs_s, c.paired_runs)
                          : "none")

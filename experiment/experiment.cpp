@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "common/config_error.hpp"
-#include "common/process.hpp"
 #include "common/domain_claim.hpp"
+#include "common/process.hpp"
+#include "experiment/report.hpp"
 #include "ground_station/gs_app.hpp"
 #include "launcher/launcher.hpp"
-#include "experiment/report.hpp"
 
 namespace ddswarm::gs {
 
@@ -218,8 +218,7 @@ void start_run_processes(Launcher& procs, const RunPlan& p, int domain, const st
                  common_args(agent_command(bin, shares[h], true, p.scenario_file, true))});
   for (int i = 0; opt.agent_hosts == 0 && i < p.rec.drones; ++i)
     procs.start({"agent " + std::to_string(i),
-                 common_args(agent_command(bin, std::to_string(i), false, p.scenario_file,
-                                           true))});
+                 common_args(agent_command(bin, std::to_string(i), false, p.scenario_file, true))});
 }
 
 /// How one start of a run ended: its outcome, and the processes that ended
@@ -309,9 +308,15 @@ RunRecord finished_record(RunRecord rec, const RunStart& r, double run_start) {
 /// The runs of one experiment, flown by `jobs` workers, each on a domain of
 /// its own: what they share (the output, the counters, the records) under mu.
 struct ExperimentRuns {
-  ExperimentRuns(const ExperimentOptions& opt, std::vector<RunPlan>& plans, std::ostream& out, std::string bin,
-                 std::string csv, int total, double t0)
-      : opt(opt), plans(plans), out(out), bin(std::move(bin)), csv(std::move(csv)), total(total), t0(t0),
+  ExperimentRuns(const ExperimentOptions& opt, std::vector<RunPlan>& plans, std::ostream& out,
+                 std::string bin, std::string csv, int total, double t0)
+      : opt(opt),
+        plans(plans),
+        out(out),
+        bin(std::move(bin)),
+        csv(std::move(csv)),
+        total(total),
+        t0(t0),
         records(plans.size()) {}
 
   const ExperimentOptions& opt;
@@ -349,8 +354,8 @@ struct ExperimentRuns {
       r = start_and_fly(p, starts, domain, bin, opt, run_start, times);
       if (stop_requested() || !start_run_again(r.o, !r.died.empty(), starts)) break;
       std::lock_guard<std::mutex> lock(mu);
-      out << fmt::format("  {}: {}; starting the run again ({} of {})", p.tag, r.o.reason, starts + 1,
-                         kRunStarts)
+      out << fmt::format("  {}: {}; starting the run again ({} of {})", p.tag, r.o.reason,
+                         starts + 1, kRunStarts)
           << std::endl;
     }
     const RunRecord rec = finished_record(p.rec, r, run_start);
@@ -361,15 +366,16 @@ struct ExperimentRuns {
     sum.startup_s += times.startup_s;
     sum.flight_s += times.flight_s;
     sum.teardown_s += times.teardown_s;
-    out << "  " << p.tag << ": " << (rec.ok ? r.o.line() : "FAILED: " + rec.failure_reason) << std::endl;
+    out << "  " << p.tag << ": " << (rec.ok ? r.o.line() : "FAILED: " + rec.failure_reason)
+        << std::endl;
     records[index] = rec;
   }
 };
 
 /// The experiment's table (out_dir/<name>.md and out) and plots, and where
 /// its wall time went; returns the exit code.
-int report_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, ExperimentRuns& runs,
-                      int jobs) {
+int report_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt,
+                      ExperimentRuns& runs, int jobs) {
   std::ostream& out = runs.out;
   std::vector<RunRecord> finished_records;
   for (auto& r : runs.records)
@@ -395,11 +401,13 @@ int report_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt,
   const double busy = sum.startup_s + sum.flight_s + sum.teardown_s;
   if (runs.done > 0 && busy > 0)
     out << fmt::format(
-        "wall time per run (summed over {} runs, {} at a time): start-up {:.1f} s ({:.0f} %), flight {:.1f} s "
+        "wall time per run (summed over {} runs, {} at a time): start-up {:.1f} s ({:.0f} %), "
+        "flight {:.1f} s "
         "({:.0f} %), teardown {:.1f} s ({:.0f} %)\n",
-        runs.done, jobs, sum.startup_s, 100 * sum.startup_s / busy, sum.flight_s, 100 * sum.flight_s / busy,
-        sum.teardown_s, 100 * sum.teardown_s / busy);
-  out << fmt::format("{} runs, {} failed, {} wall; CSV {}\n", runs.done, runs.failed, clock(wall), runs.csv);
+        runs.done, jobs, sum.startup_s, 100 * sum.startup_s / busy, sum.flight_s,
+        100 * sum.flight_s / busy, sum.teardown_s, 100 * sum.teardown_s / busy);
+  out << fmt::format("{} runs, {} failed, {} wall; CSV {}\n", runs.done, runs.failed, clock(wall),
+                     runs.csv);
   return runs.failed == 0 && runs.done == runs.total ? 0 : 1;
 }
 
@@ -425,8 +433,8 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
 
   std::vector<RunPlan> plans = plan_runs(cfg, opt);
   check_sets(cfg, plans, bin);
-  out << fmt::format("experiment '{}': {} sets x {} runs, {} mode, {} at a time, results in {}\n", cfg.name,
-                     cfg.sets.size(), cfg.runs_per_set, cfg.mode, jobs, opt.out_dir);
+  out << fmt::format("experiment '{}': {} sets x {} runs, {} mode, {} at a time, results in {}\n",
+                     cfg.name, cfg.sets.size(), cfg.runs_per_set, cfg.mode, jobs, opt.out_dir);
   for (const auto& why : skipped) out << "  not on " << why << "\n";
   out << "  runs on DDS domain" << (jobs > 1 ? "s" : "");
   for (std::size_t w = 0; w < domains.size(); ++w) out << (w ? ", " : " ") << domains[w].domain();
@@ -437,7 +445,8 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
   std::vector<std::thread> workers;
   for (int w = 0; w < jobs; ++w)
     workers.emplace_back([&, w] {
-      for (int i = next++; i < total && !stop_requested(); i = next++) runs.run_one(i, domains[w].domain());
+      for (int i = next++; i < total && !stop_requested(); i = next++)
+        runs.run_one(i, domains[w].domain());
     });
   for (auto& t : workers) t.join();
   return report_experiment(cfg, opt, runs, jobs);

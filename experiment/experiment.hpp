@@ -6,8 +6,8 @@
 #include <string>
 
 #include "common/dds_config.hpp"
-#include "ground_station/dds_commander.hpp"
 #include "experiment/experiment_config.hpp"
+#include "ground_station/dds_commander.hpp"
 #include "ground_station/gs_config.hpp"
 
 namespace ddswarm::gs {
@@ -45,9 +45,9 @@ struct ExperimentOptions {
   std::string out_dir = "results";  ///< CSV, table, plots, per-run scenarios and logs go here
   DdsConfig dds;                    ///< domain and network of every run
   GroundStationConfig gs;
-  std::string bin_dir;              ///< where ddswarm-sim / ddswarm-agent live (default: next to us)
-  std::string record_dir;           ///< when set, each run's DDS traffic goes to <record_dir>/<run>.mcap
-  int jobs = 1;                     ///< runs at a time, each job on a domain of its own from dds.domain_id up
+  std::string bin_dir;     ///< where ddswarm-sim / ddswarm-agent live (default: next to us)
+  std::string record_dir;  ///< when set, each run's DDS traffic goes to <record_dir>/<run>.mcap
+  int jobs = 1;  ///< runs at a time, each job on a domain of its own from dds.domain_id up
   /// 0: one ddswarm-agent process per drone; K > 0: each run's agents in K
   /// agent-host processes (ddswarm-agent --ids). Lockstep results are the same
   /// to the last digit (mp_agent_host, mp_experiment_short); large swarms fly

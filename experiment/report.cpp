@@ -564,11 +564,12 @@ std::vector<SetSummary> summarize(const std::vector<RunRecord>& records) {
   return out;
 }
 
-
 namespace {
 /// A Markdown table: one column per set, one row per (label, cell of a set).
-std::string sets_table(const std::vector<SetSummary>& sets,
-                       const std::vector<std::pair<std::string, std::function<std::string(const SetSummary&)>>>& rows) {
+std::string sets_table(
+    const std::vector<SetSummary>& sets,
+    const std::vector<std::pair<std::string, std::function<std::string(const SetSummary&)>>>&
+        rows) {
   std::ostringstream os;
   os << "| |";
   for (const auto& s : sets) os << ' ' << md_cell(s.name) << " |";
@@ -681,8 +682,9 @@ std::vector<std::string> write_plots(const std::vector<RunRecord>& records,
     pngs.push_back(render_gnuplot(dir, stem, plot_body(stem, summaries[i], max_run), 800, 500));
   }
   // The summary needs a mean to draw: with every run failed, gnuplot finds no point at all.
-  const bool any_mean = std::any_of(summaries.begin(), summaries.end(),
-                                    [](const SetSummary& s) { return std::isfinite(s.mean_time_s); });
+  const bool any_mean = std::any_of(summaries.begin(), summaries.end(), [](const SetSummary& s) {
+    return std::isfinite(s.mean_time_s);
+  });
   if (summaries.size() > 1 && any_mean) pngs.push_back(write_summary_plot(summaries, dir));
   if (std::any_of(summaries.begin(), summaries.end(),
                   [](const SetSummary& s) { return s.metrics_runs > 0; }))

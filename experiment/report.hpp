@@ -67,12 +67,12 @@ struct SetSummary {
   std::string mode;             ///< from the set's first run
   int runs = 0;                 ///< runs recorded
   int failures = 0;             ///< runs with ok == false
-  int successes = 0;  ///< runs with ok and a finite task time (what the time statistics use)
-  double mean_time_s = 0;       ///< s, mean task time of successful runs (NaN: none)
-  double stddev_time_s = 0;     ///< s, sample standard deviation (n-1) of the same (NaN: < 2)
-  double min_time_s = 0;        ///< s, over successful runs (NaN: none)
-  double max_time_s = 0;        ///< s, over successful runs (NaN: none)
-  double mean_collisions = 0;   ///< all collisions per run, over every run
+  int successes = 0;         ///< runs with ok and a finite task time (what the time statistics use)
+  double mean_time_s = 0;    ///< s, mean task time of successful runs (NaN: none)
+  double stddev_time_s = 0;  ///< s, sample standard deviation (n-1) of the same (NaN: < 2)
+  double min_time_s = 0;     ///< s, over successful runs (NaN: none)
+  double max_time_s = 0;     ///< s, over successful runs (NaN: none)
+  double mean_collisions = 0;  ///< all collisions per run, over every run
   double mean_collisions_obstacle = 0;
   double mean_collisions_drone = 0;
   double mean_collisions_ground = 0;
@@ -80,14 +80,14 @@ struct SetSummary {
   double min_clearance_m = 0;    ///< m, smallest over every run (inf: none recorded)
   double mean_wall_time_s = 0;   ///< s, mean wall-clock time per run
   // Swarm metrics, over the runs that measured them (metrics_runs; NaN: none).
-  int metrics_runs = 0;          ///< runs with a measured order_mean
-  double mean_order = 0;         ///< mean of the runs' order_mean
-  double min_order = 0;          ///< smallest order_min of a run
-  double mean_speed_mps = 0;     ///< m/s, mean of the runs' speed_mean_mps
-  double mean_near_misses = 0;   ///< near misses per run
-  int max_components = 0;        ///< most components of a run (0: none measured)
-  double min_lambda2 = 0;        ///< smallest lambda2_min of a run
-  bool consistent = true;        ///< false when runs disagree on drones/D_int/speed/sensor/mode
+  int metrics_runs = 0;         ///< runs with a measured order_mean
+  double mean_order = 0;        ///< mean of the runs' order_mean
+  double min_order = 0;         ///< smallest order_min of a run
+  double mean_speed_mps = 0;    ///< m/s, mean of the runs' speed_mean_mps
+  double mean_near_misses = 0;  ///< near misses per run
+  int max_components = 0;       ///< most components of a run (0: none measured)
+  double min_lambda2 = 0;       ///< smallest lambda2_min of a run
+  bool consistent = true;       ///< false when runs disagree on drones/D_int/speed/sensor/mode
 };
 
 /// One summary per set name, in the order sets first appear in records.

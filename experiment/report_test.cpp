@@ -402,8 +402,8 @@ TEST_F(ReportTest, MetricsPlotShowsOrderAndClosestApproachPerSet) {
 // instead of failing the whole report.
 TEST_F(ReportTest, EveryRunFailedPlotsTheSetsWithoutASummary) {
   if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed";
-  const auto pngs = write_plots({run("Sim 1", 0, kNaN, false), run("Sim 2", 0, kNaN, false)},
-                                path("plots"));
+  const auto pngs =
+      write_plots({run("Sim 1", 0, kNaN, false), run("Sim 2", 0, kNaN, false)}, path("plots"));
   ASSERT_EQ(pngs.size(), 2u);
   EXPECT_EQ(pngs[1], path("plots/sim_2.png"));
   EXPECT_FALSE(fs::exists(path("plots/summary.png")));

@@ -37,16 +37,17 @@ struct SwarmStatus {
   /// the server's SimStatus rejected_* counters, then "agents" (the sum of every
   /// agent's AgentStatus.rejected_samples). Empty when nothing was heard.
   std::vector<std::pair<std::string, std::uint64_t>> rejected;
-  int failsafe = 0;             ///< drones in failsafe (agent lost: hovering or landing)
+  int failsafe = 0;  ///< drones in failsafe (agent lost: hovering or landing)
   /// Velocity commands the server applied since start, and (real time) those
   /// that arrived after the step they answered; -1 = no server heard.
   std::int64_t commands_applied = -1;
   std::int64_t commands_late = -1;
   /// Lockstep: ticks the server published again, answers missing (SimStatus.lockstep_resends).
   std::int64_t lockstep_resends = -1;
-  std::string task;             ///< the refereed task, e.g. "running 12.0 s, 2/6 past finish"; "" = none
+  std::string task;  ///< the refereed task, e.g. "running 12.0 s, 2/6 past finish"; "" = none
   int drones_server_hears = -1;  ///< drones whose agent the server lists live (-1: no server heard)
-  std::string laws;  ///< the swarm laws the agents fly, e.g. "4 thesis, 2 vasarhelyi"; "" = none heard
+  std::string
+      laws;  ///< the swarm laws the agents fly, e.g. "4 thesis, 2 vasarhelyi"; "" = none heard
   /// Drones whose law faulted, e.g. "drone 3 (reynolds): threw: ...".
   std::vector<std::string> law_faults;
 };

@@ -28,7 +28,8 @@ std::string measured(double v, int decimals) {
 
 std::string TaskOutcome::line() const {
   std::string lost;
-  if (!lost_drones.empty()) lost = fmt::format("; lost drones (agent lost, failsafe): {}", fmt::join(lost_drones, ", "));
+  if (!lost_drones.empty())
+    lost = fmt::format("; lost drones (agent lost, failsafe): {}", fmt::join(lost_drones, ", "));
   if (!ok) return "task failed: " + reason + lost;
   const SwarmTaskMetrics& m = metrics;
   const std::string swarm = fmt::format(
@@ -36,11 +37,13 @@ std::string TaskOutcome::line() const {
       measured(m.order_mean, 2), measured(m.order_min, 2), measured(m.speed_mean_mps, 2),
       m.near_misses, m.components_max, measured(m.lambda2_min, 2));
   return fmt::format(
-      "task complete: {:.2f} s sim time (wall {:.1f} s), {} drones at {:.2f} m/s, collisions: "
-      "obstacle {}, drone {}, ground {}; min inter-drone distance {:.2f} m, min obstacle "
-      "clearance {:.2f} m",
-      task_time_s, wall_time_s, drones, speed_mps, collisions_obstacle, collisions_drone,
-      collisions_ground, min_inter_drone_m, min_clearance_m) + swarm + lost;
+             "task complete: {:.2f} s sim time (wall {:.1f} s), {} drones at {:.2f} m/s, "
+             "collisions: "
+             "obstacle {}, drone {}, ground {}; min inter-drone distance {:.2f} m, min obstacle "
+             "clearance {:.2f} m",
+             task_time_s, wall_time_s, drones, speed_mps, collisions_obstacle, collisions_drone,
+             collisions_ground, min_inter_drone_m, min_clearance_m) +
+         swarm + lost;
 }
 
 namespace {
@@ -106,11 +109,12 @@ struct DdsCommander::Impl {
       scene_seed = sc.seed();
       scene_name = sc.name().to_string();
     });
-    task_reader = &dds.reader<msg::TaskStatus>([this](const msg::TaskStatus& t, const fdds::SampleInfo&) {
-      std::lock_guard<std::mutex> lock(mu);
-      task = t;
-      cv.notify_all();
-    });
+    task_reader =
+        &dds.reader<msg::TaskStatus>([this](const msg::TaskStatus& t, const fdds::SampleInfo&) {
+          std::lock_guard<std::mutex> lock(mu);
+          task = t;
+          cv.notify_all();
+        });
     dds.reader<msg::AgentStatus>([this](const msg::AgentStatus& a, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
       auto& s = agents[a.drone_id()];
@@ -123,12 +127,13 @@ struct DdsCommander::Impl {
       s.law_fault = a.law_fault().to_string();
       cv.notify_all();
     });
-    ack_reader = &dds.reader<msg::MissionAck>([this](const msg::MissionAck& a, const fdds::SampleInfo&) {
-      std::lock_guard<std::mutex> lock(mu);
-      if (a.issuer_instance() != instance) return;
-      acks[a.seq()][a.drone_id()] = a;
-      cv.notify_all();
-    });
+    ack_reader =
+        &dds.reader<msg::MissionAck>([this](const msg::MissionAck& a, const fdds::SampleInfo&) {
+          std::lock_guard<std::mutex> lock(mu);
+          if (a.issuer_instance() != instance) return;
+          acks[a.seq()][a.drone_id()] = a;
+          cv.notify_all();
+        });
   }
 
   /// count, or every drone of the server's scenario when count < 0. Needs sim.
@@ -169,7 +174,8 @@ struct DdsCommander::Impl {
   template <class Pred>
   bool wait(double timeout_s, Pred done) {
     using namespace std::chrono;
-    const auto end = steady_clock::now() + duration_cast<steady_clock::duration>(duration<double>(timeout_s));
+    const auto end =
+        steady_clock::now() + duration_cast<steady_clock::duration>(duration<double>(timeout_s));
     std::unique_lock<std::mutex> lock(mu);
     // A signal handler cannot notify cv, and with no server nothing else
     // does: look at the stop flag (Ctrl-C) every 100 ms.
@@ -205,8 +211,9 @@ struct DdsCommander::Impl {
     std::set<std::string> processes;
     for (int id : online_locked()) {
       auto it = agents.find(id);
-      processes.insert(it != agents.end() && !it->second.process.empty() ? it->second.process
-                                                                          : "drone " + std::to_string(id));
+      processes.insert(it != agents.end() && !it->second.process.empty()
+                           ? it->second.process
+                           : "drone " + std::to_string(id));
     }
     return w_mission.matched() > 0 && ack_reader->matched() >= static_cast<int>(processes.size());
   }
@@ -282,7 +289,8 @@ struct DdsCommander::Impl {
     r.ok = missing.empty() && rejected.empty();
     r.message = fmt::format("{} {}/{} acknowledged", to_string(c.type), accepted, expect.size());
     if (via_server > 0) r.message += fmt::format(" ({} through the server)", via_server);
-    if (!missing.empty()) r.message += fmt::format("; no ack from drones {}", fmt::join(missing, ", "));
+    if (!missing.empty())
+      r.message += fmt::format("; no ack from drones {}", fmt::join(missing, ", "));
     if (!rejected.empty()) r.message += "; " + rejected;
     if (c.type == MissionType::kTask) task_seq = s;
     return r;
@@ -313,9 +321,12 @@ bool DdsCommander::wait_for_online(int count, double timeout_s) {
 
 bool DdsCommander::wait_for_server(double timeout_s) {
   auto& I = *impl_;
-  auto everyone = [&] { return I.sim && I.online_locked().size() >= I.sim->agents_live() && I.all_matched(); };
+  auto everyone = [&] {
+    return I.sim && I.online_locked().size() >= I.sim->agents_live() && I.all_matched();
+  };
   // First the server, for up to the discovery timeout.
-  if (!I.wait(timeout_s, [&] { return everyone() || (I.sim && I.w_mission.matched() > 0); })) return false;
+  if (!I.wait(timeout_s, [&] { return everyone() || (I.sim && I.w_mission.matched() > 0); }))
+    return false;
   // Then every live agent's ack writer, for up to the ack timeout: an ack
   // written before it matched our reader could be lost. A frozen or
   // unreachable agent never matches, so go on after that and let the
@@ -450,7 +461,8 @@ bool DdsCommander::wait_task_status(double timeout_s) {
 
 bool DdsCommander::attach_task(double timeout_s) {
   auto& I = *impl_;
-  bool ok = I.wait_latched_task(timeout_s, timeout_s, [&] { return I.task && I.task->phase() != msg::TASK_NONE; });
+  bool ok = I.wait_latched_task(timeout_s, timeout_s,
+                                [&] { return I.task && I.task->phase() != msg::TASK_NONE; });
   std::lock_guard<std::mutex> lock(I.mu);
   if (!ok || !I.task) return false;
   I.task_seq = I.task->seq();
@@ -510,7 +522,10 @@ std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_p
     if (silent > 1.0 && !server_lost) {
       server_lost = true;
       lock.unlock();
-      if (on_progress) on_progress(fmt::format("server lost: no status for {:.1f} s; waiting up to {:.0f} s for it", silent, I.cfg.server_timeout_s));
+      if (on_progress)
+        on_progress(
+            fmt::format("server lost: no status for {:.1f} s; waiting up to {:.0f} s for it",
+                        silent, I.cfg.server_timeout_s));
       lock.lock();
     }
     if (silent > I.cfg.server_timeout_s) {
@@ -518,8 +533,9 @@ std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_p
       break;
     }
     if (I.sim && I.sim->server_instance() != server_instance) {
-      o.reason = fmt::format("server restarted (instance {:016x}, was {:016x}): the task ended with the old world",
-                             I.sim->server_instance(), server_instance);
+      o.reason = fmt::format(
+          "server restarted (instance {:016x}, was {:016x}): the task ended with the old world",
+          I.sim->server_instance(), server_instance);
       break;
     }
     if (server_lost && silent <= 1.0) {
@@ -530,9 +546,10 @@ std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_p
     }
     if (on_progress && now - last_progress >= 2.0 && mine) {
       last_progress = now;
-      std::string p = fmt::format("t={:.1f} s: {}/{} past finish, widest pair {:.1f} m (epsilon {:.1f} m)",
-                                  I.task->elapsed_s(), I.task->past_finish(), I.task->drones(),
-                                  I.task->max_pair_distance_m(), I.task->epsilon_m());
+      std::string p =
+          fmt::format("t={:.1f} s: {}/{} past finish, widest pair {:.1f} m (epsilon {:.1f} m)",
+                      I.task->elapsed_s(), I.task->past_finish(), I.task->drones(),
+                      I.task->max_pair_distance_m(), I.task->epsilon_m());
       lock.unlock();
       on_progress(p);
       lock.lock();
@@ -554,7 +571,8 @@ SwarmStatus DdsCommander::status() {
     s.drones_total = m.num_drones();
     s.drones_server_hears = static_cast<int>(m.live_agents().size());
     s.airborne = m.airborne();
-    s.collisions = static_cast<int>(m.collisions_obstacle() + m.collisions_drone() + m.collisions_ground());
+    s.collisions =
+        static_cast<int>(m.collisions_obstacle() + m.collisions_drone() + m.collisions_ground());
     s.mode = (m.mode() == msg::MODE_LOCKSTEP ? "lockstep, " : "realtime, ") + m.state().to_string();
   } else {
     s.real_time_factor = std::nan("");
@@ -564,7 +582,8 @@ SwarmStatus DdsCommander::status() {
   if (impl_->task) {
     const auto& t = *impl_->task;
     if (t.phase() == msg::TASK_RUNNING)
-      s.task = fmt::format("running {:.1f} s, {}/{} past finish", t.elapsed_s(), t.past_finish(), t.drones());
+      s.task = fmt::format("running {:.1f} s, {}/{} past finish", t.elapsed_s(), t.past_finish(),
+                           t.drones());
     else if (t.phase() == msg::TASK_COMPLETE)
       s.task = fmt::format("complete in {:.2f} s", t.elapsed_s());
     else if (t.phase() == msg::TASK_FAILED)
@@ -577,10 +596,11 @@ SwarmStatus DdsCommander::status() {
     s.commands_applied = static_cast<std::int64_t>(m.commands_applied());
     s.commands_late = static_cast<std::int64_t>(m.commands_late());
     s.lockstep_resends = static_cast<std::int64_t>(m.lockstep_resends());
-    s.rejected = {{"non-finite", m.rejected_non_finite()}, {"absurd", m.rejected_absurd()},
-                  {"unknown id", m.rejected_unknown_id()}, {"stale tick", m.rejected_stale_tick()},
-                  {"future tick", m.rejected_future_tick()}, {"impostor", m.rejected_impostor()},
-                  {"mission", m.rejected_mission()}, {"malformed", m.rejected_malformed()}};
+    s.rejected = {
+        {"non-finite", m.rejected_non_finite()},   {"absurd", m.rejected_absurd()},
+        {"unknown id", m.rejected_unknown_id()},   {"stale tick", m.rejected_stale_tick()},
+        {"future tick", m.rejected_future_tick()}, {"impostor", m.rejected_impostor()},
+        {"mission", m.rejected_mission()},         {"malformed", m.rejected_malformed()}};
   }
   if (!impl_->agents.empty()) {
     std::uint64_t by_agents = 0;
@@ -590,26 +610,31 @@ SwarmStatus DdsCommander::status() {
   std::map<std::string, int> laws;
   for (const auto& [id, a] : impl_->agents) {
     if (!a.law.empty()) laws[a.law]++;
-    if (!a.law_fault.empty()) s.law_faults.push_back(fmt::format("drone {} ({}): {}", id, a.law, a.law_fault));
+    if (!a.law_fault.empty())
+      s.law_faults.push_back(fmt::format("drone {} ({}): {}", id, a.law, a.law_fault));
   }
-  for (const auto& [l, k] : laws) s.laws += fmt::format("{}{} {}", s.laws.empty() ? "" : ", ", k, l);
+  for (const auto& [l, k] : laws)
+    s.laws += fmt::format("{}{} {}", s.laws.empty() ? "" : ", ", k, l);
   std::map<Phase, int> phases;
   for (const auto& [id, a] : impl_->agents) phases[a.phase]++;
-  for (const auto& [p, k] : phases) s.task_phase += fmt::format("{}{} {}", s.task_phase.empty() ? "" : ", ", k, to_string(p));
+  for (const auto& [p, k] : phases)
+    s.task_phase += fmt::format("{}{} {}", s.task_phase.empty() ? "" : ", ", k, to_string(p));
   return s;
 }
 
 std::optional<SwarmSnapshot> DdsCommander::swarm_snapshot(double timeout_s) {
   Impl& m = *impl_;
   if (!m.state_reader) {
-    m.state_reader = &m.dds.reader<msg::SwarmState>([&m](const msg::SwarmState& s, const fdds::SampleInfo&) {
-      std::lock_guard<std::mutex> lock(m.mu);
-      m.state = s;
-      m.cv.notify_all();
-    });
+    m.state_reader =
+        &m.dds.reader<msg::SwarmState>([&m](const msg::SwarmState& s, const fdds::SampleInfo&) {
+          std::lock_guard<std::mutex> lock(m.mu);
+          m.state = s;
+          m.cv.notify_all();
+        });
   }
   std::unique_lock<std::mutex> lock(m.mu);
-  m.cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return m.state.has_value(); });
+  m.cv.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                [&] { return m.state.has_value(); });
   if (!m.state) return std::nullopt;
   return snapshot_of(*m.state);
 }

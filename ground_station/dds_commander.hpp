@@ -23,19 +23,19 @@ struct TaskOutcome {
   /// failed before the swarm was up (the server never heard every agent):
   /// a start-up failure, not a result of the task
   bool never_up = false;
-  double task_time_s = 0;    ///< s sim
-  double wall_time_s = 0;    ///< s wall
+  double task_time_s = 0;  ///< s sim
+  double wall_time_s = 0;  ///< s wall
   double epsilon_m = 0;
   double speed_mps = 0;
   int drones = 0;
   int collisions_obstacle = 0, collisions_drone = 0, collisions_ground = 0;
   double min_inter_drone_m = 0;
   double min_clearance_m = 0;
-  std::uint64_t seed = 0;     ///< the scenario's seed (from the server's Scene)
-  std::string scenario;       ///< the scenario's name
+  std::uint64_t seed = 0;        ///< the scenario's seed (from the server's Scene)
+  std::string scenario;          ///< the scenario's name
   std::vector<int> lost_drones;  ///< drones whose agent was lost during the task
   SwarmTaskMetrics metrics;      ///< the task's swarm metrics, as the server gathered them
-  std::string line() const;  ///< the one-line result
+  std::string line() const;      ///< the one-line result
 };
 
 /// What the ground station knows of one agent while it waits for a take-off

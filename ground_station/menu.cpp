@@ -440,13 +440,14 @@ std::string format_status(const SwarmStatus& s) {
   if (!s.task.empty()) os << " | task " << s.task;
   os << " | D_int " << s.d_int_m << " m";
   // The laws only when the swarm flies more than the thesis's.
-  if (!s.laws.empty() && s.laws.find(',') == std::string::npos && s.laws.find(" thesis") == std::string::npos)
+  if (!s.laws.empty() && s.laws.find(',') == std::string::npos &&
+      s.laws.find(" thesis") == std::string::npos)
     os << " | law " << s.laws.substr(s.laws.find(' ') + 1);
   else if (s.laws.find(',') != std::string::npos)
     os << " | laws " << s.laws;
   if (!s.law_faults.empty())
-    os << " | " << s.law_faults.size() << " law fault" << (s.law_faults.size() > 1 ? "s" : "") << ": "
-       << s.law_faults.front();
+    os << " | " << s.law_faults.size() << " law fault" << (s.law_faults.size() > 1 ? "s" : "")
+       << ": " << s.law_faults.front();
   os << "]";
   return os.str();
 }

@@ -347,7 +347,8 @@ TEST(Status, RejectionsAreCountedByReason) {
   SwarmStatus s;
   EXPECT_EQ(format_rejections(s), "rejected samples: unknown (no server or agent heard)");
   s.rejected = {{"non-finite", 3}, {"absurd", 0}, {"mission", 2}, {"agents", 1}};
-  EXPECT_EQ(format_rejections(s), "rejected samples: 6 (non-finite 3, absurd 0, mission 2, agents 1)");
+  EXPECT_EQ(format_rejections(s),
+            "rejected samples: 6 (non-finite 3, absurd 0, mission 2, agents 1)");
 }
 
 TEST(Status, CommandsAppliedAndLate) {

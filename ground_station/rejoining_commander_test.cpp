@@ -46,7 +46,10 @@ struct Rig {
                             throw std::runtime_error("no DDS");
                           return std::make_unique<Numbered>(++made);
                         },
-                        3.0, log, [this] { return now.load(); }, 0.002};
+                        3.0,
+                        log,
+                        [this] { return now.load(); },
+                        0.002};
 
   // Lets the watch turn a few times at the clock's present reading.
   void settle() { std::this_thread::sleep_for(std::chrono::milliseconds(30)); }

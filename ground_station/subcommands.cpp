@@ -45,18 +45,26 @@ void add_gs_command_line(CLI::App& app, GsCommandLine& cl) {
   app.add_option("--config", cl.config, "scenario YAML (ground_station, task and dds sections)");
   add_dds_options(app, cl.dds_cli);
   app.add_option("--web", cl.web_addr,
-                 "serve the live 3D view at ADDR:PORT (e.g. 127.0.0.1:8080; port 0 = any free one) until Ctrl-C");
-  app.add_option("--web-root", cl.web_root, "the page's files (default: the source tree's ground_station/web/www)");
-  app.add_flag("--web-allow-remote", cl.web_remote, "allow --web on a non-loopback address (the page commands the swarm)");
-  app.add_option("--web-max-upload-mb", cl.web_upload_mb, "largest recording the page may upload (MiB)");
-  app.add_option("--web-duration", cl.web_duration, "with --web: stop after this many wall seconds (0 = until Ctrl-C)");
+                 "serve the live 3D view at ADDR:PORT (e.g. 127.0.0.1:8080; port 0 = any free one) "
+                 "until Ctrl-C");
+  app.add_option("--web-root", cl.web_root,
+                 "the page's files (default: the source tree's ground_station/web/www)");
+  app.add_flag("--web-allow-remote", cl.web_remote,
+               "allow --web on a non-loopback address (the page commands the swarm)");
+  app.add_option("--web-max-upload-mb", cl.web_upload_mb,
+                 "largest recording the page may upload (MiB)");
+  app.add_option("--web-duration", cl.web_duration,
+                 "with --web: stop after this many wall seconds (0 = until Ctrl-C)");
 
   cl.menu = app.add_subcommand("menu", "interactive console (the default)");
-  auto* wait_agents = cl.wait_agents = app.add_subcommand("wait-agents", "wait until the server and N agents are online");
+  auto* wait_agents = cl.wait_agents =
+      app.add_subcommand("wait-agents", "wait until the server and N agents are online");
   wait_agents->add_option("--count", cl.wait_count, "agents to wait for (default: all drones)");
-  wait_agents->add_option("--timeout", cl.wait_timeout, "seconds")->check(finite_range(0.0, 86400.0));
+  wait_agents->add_option("--timeout", cl.wait_timeout, "seconds")
+      ->check(finite_range(0.0, 86400.0));
   auto* takeoff = cl.takeoff = app.add_subcommand("takeoff", "take off and hold");
-  takeoff->add_option("--altitude", cl.altitude, "m above ground (0 = agents' default)")->check(finite_range(0.0, 1000.0));
+  takeoff->add_option("--altitude", cl.altitude, "m above ground (0 = agents' default)")
+      ->check(finite_range(0.0, 1000.0));
   takeoff->add_flag("--wait", cl.wait_flag, "wait until every drone has reached its altitude");
   auto* move = cl.move = app.add_subcommand("move", "move the swarm by velocity for a time");
   move->add_option("--north", cl.north, "m/s")->check(finite_range(-50.0, 50.0));
@@ -64,47 +72,70 @@ void add_gs_command_line(CLI::App& app, GsCommandLine& cl) {
   move->add_option("--up", cl.up, "m/s")->check(finite_range(-50.0, 50.0));
   move->add_option("--time", cl.time_s, "s")->required()->check(finite_range(0.0, 86400.0));
   move->add_flag("--wait", cl.wait_flag, "wait until the move's time has passed (sim time)");
-  auto* distance = cl.distance = app.add_subcommand("distance", "change the inter-drone distance D_int");
-  distance->add_option("metres", cl.d_int, "new D_int (m)")->required()->check(finite_range(0.31, 1000.0));
+  auto* distance = cl.distance =
+      app.add_subcommand("distance", "change the inter-drone distance D_int");
+  distance->add_option("metres", cl.d_int, "new D_int (m)")
+      ->required()
+      ->check(finite_range(0.31, 1000.0));
   auto* land = cl.land = app.add_subcommand("land", "land every drone");
   land->add_flag("--wait", cl.wait_flag, "wait until every drone is on the ground");
   auto* hold = cl.hold = app.add_subcommand("hold", "stop mission motion, keep swarming");
-  hold->add_option("--time", cl.hold_s, "swarm in place for this many sim seconds (lockstep runs the clock meanwhile)")
+  hold->add_option("--time", cl.hold_s,
+                   "swarm in place for this many sim seconds (lockstep runs the clock meanwhile)")
       ->check(finite_range(0.0, 86400.0));
   hold->add_flag("--wait", cl.wait_flag, "wait until the time has passed (sim time)");
-  auto* follow = cl.follow = app.add_subcommand("follow", "follow the leader: the rest swarm around it");
-  follow->add_option("--leader", cl.leader, "leader drone id")->required()->check(CLI::Range(0, 1023));
-  auto* teleop = cl.teleop = app.add_subcommand("teleop", "set the leader's velocity while following");
+  auto* follow = cl.follow =
+      app.add_subcommand("follow", "follow the leader: the rest swarm around it");
+  follow->add_option("--leader", cl.leader, "leader drone id")
+      ->required()
+      ->check(CLI::Range(0, 1023));
+  auto* teleop = cl.teleop =
+      app.add_subcommand("teleop", "set the leader's velocity while following");
   teleop->add_option("--north", cl.north, "m/s")->check(finite_range(-50.0, 50.0));
   teleop->add_option("--east", cl.east, "m/s")->check(finite_range(-50.0, 50.0));
   teleop->add_option("--up", cl.up, "m/s")->check(finite_range(-50.0, 50.0));
-  auto* task = cl.task = app.add_subcommand("task", "run the thesis task (the swarm must be airborne)");
-  task->add_option("--speed", cl.speed, "m/s toward the goal (default: task.speed_mps)")->check(finite_range(0.0, 50.0));
-  task->add_option("--epsilon", cl.epsilon, "m, swarm condition (default: 2*D_int+1)")->check(finite_range(0.0, 10000.0));
+  auto* task = cl.task =
+      app.add_subcommand("task", "run the thesis task (the swarm must be airborne)");
+  task->add_option("--speed", cl.speed, "m/s toward the goal (default: task.speed_mps)")
+      ->check(finite_range(0.0, 50.0));
+  task->add_option("--epsilon", cl.epsilon, "m, swarm condition (default: 2*D_int+1)")
+      ->check(finite_range(0.0, 10000.0));
   task->add_flag("--no-wait", cl.no_wait, "return once accepted");
   task->add_flag("--takeoff", cl.fly, "wait for every agent, take off first, then run the task");
   task->add_option("--csv", cl.csv, "append the result to this CSV");
-  task->add_flag("--attach", cl.attach, "send nothing: report the task the server is refereeing (e.g. after a ground station died)");
+  task->add_flag(
+      "--attach", cl.attach,
+      "send nothing: report the task the server is refereeing (e.g. after a ground station died)");
   auto* status = cl.status = app.add_subcommand("status", "print the swarm's status");
-  status->add_flag("--drones", cl.status_drones, "also print every drone and the pairwise distances");
-  auto* trace = cl.trace = app.add_subcommand("trace", "write every drone's state to CSV until Ctrl-C or --duration");
+  status->add_flag("--drones", cl.status_drones,
+                   "also print every drone and the pairwise distances");
+  auto* trace = cl.trace =
+      app.add_subcommand("trace", "write every drone's state to CSV until Ctrl-C or --duration");
   trace->add_option("--out", cl.trace_out, "CSV file")->required();
   trace->add_option("--every", cl.trace_every, "keep one tick in N")->check(CLI::Range(1, 100000));
   trace->add_option("--duration", cl.trace_duration, "wall seconds (0 = until Ctrl-C)")
       ->check(finite_range(0.0, 1e9));
-  trace->add_option("--metrics", cl.trace_metrics, "also write the swarm metrics of every traced tick to this CSV");
-  trace->add_option("--metrics-range", cl.trace_metrics_range,
-                    "m, communication range of the metrics (0 = the scenario's sim.metrics_range_m)")
+  trace->add_option("--metrics", cl.trace_metrics,
+                    "also write the swarm metrics of every traced tick to this CSV");
+  trace
+      ->add_option("--metrics-range", cl.trace_metrics_range,
+                   "m, communication range of the metrics (0 = the scenario's sim.metrics_range_m)")
       ->check(finite_range(0.0, 100000.0));
-  auto* experiment = cl.experiment = app.add_subcommand("experiment", "run an experiment file (e.g. config/table1.yaml)");
+  auto* experiment = cl.experiment =
+      app.add_subcommand("experiment", "run an experiment file (e.g. config/table1.yaml)");
   experiment->add_option("file", cl.exp_file, "experiment YAML")->required();
   experiment->add_option("--out", cl.out_dir, "output directory");
-  experiment->add_option("--record", cl.record_dir, "record each run's DDS traffic to DIR/<run>.mcap");
-  experiment->add_option("--jobs", cl.jobs, "runs at a time, each on a DDS domain of its own (the first free ones from --domain up)")
+  experiment->add_option("--record", cl.record_dir,
+                         "record each run's DDS traffic to DIR/<run>.mcap");
+  experiment
+      ->add_option(
+          "--jobs", cl.jobs,
+          "runs at a time, each on a DDS domain of its own (the first free ones from --domain up)")
       ->check(CLI::Range(1, 16));
-  experiment->add_option("--agent-hosts", cl.exp_agent_hosts,
-                         "each run's agents in K ddswarm-agent --ids processes instead of one per drone "
-                         "(the same lockstep results, faster for large swarms)")
+  experiment
+      ->add_option("--agent-hosts", cl.exp_agent_hosts,
+                   "each run's agents in K ddswarm-agent --ids processes instead of one per drone "
+                   "(the same lockstep results, faster for large swarms)")
       ->check(CLI::Range(0, 1024));
   experiment->add_option("--set", cl.exp_sets,
                          "override a scenario key in every set, over the set's own value, e.g. "
@@ -131,7 +162,8 @@ void add_gs_command_line(CLI::App& app, GsCommandLine& cl) {
 }
 
 int run_gs(CLI::App& app, GsCommandLine& cl) {
-  if (*cl.compare) return compare_experiments(cl.cmp_files, cl.cmp_labels, cl.cmp_plot, cl.cmp_fail);
+  if (*cl.compare)
+    return compare_experiments(cl.cmp_files, cl.cmp_labels, cl.cmp_plot, cl.cmp_fail);
   spdlog::set_level(spdlog::level::warn);
   auto file = load_gs_config(cl.config);
   merge_cli(file.dds, cl.dds_cli, app);
@@ -144,8 +176,10 @@ int run_gs(CLI::App& app, GsCommandLine& cl) {
   install_stop_signals();
 
   if (!cl.web_addr.empty()) {
-    if (!app.get_subcommands().empty()) throw FieldError("--web", cl.web_addr, "takes no subcommand");
-    return serve_web(file, cl.web_addr, cl.web_root, cl.web_remote, cl.web_upload_mb, cl.web_duration);
+    if (!app.get_subcommands().empty())
+      throw FieldError("--web", cl.web_addr, "takes no subcommand");
+    return serve_web(file, cl.web_addr, cl.web_root, cl.web_remote, cl.web_upload_mb,
+                     cl.web_duration);
   }
   if (*cl.experiment) return experiment_command(file, cl);
   if (*cl.trace) return trace_command(cl.config, file, cl);
@@ -160,7 +194,8 @@ int run_gs(CLI::App& app, GsCommandLine& cl) {
   DdsCommander& gs = *commander;
   if (!ready && !interactive) {
     if (stop_requested()) return 1;  // interrupted while discovering: reported below
-    std::fprintf(stderr, "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",
+    std::fprintf(stderr,
+                 "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",
                  file.dds.domain_id, file.gs.discovery_timeout_s);
     return 1;
   }
@@ -191,8 +226,8 @@ void append_result(const std::string& csv, const TaskOutcome& o, int drones) {
   append_csv(csv, rec);
 }
 
-int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root, bool remote,
-              double upload_mb, double duration_s) {
+int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root,
+              bool remote, double upload_mb, double duration_s) {
   web::WebBridgeOptions o;
   web::parse_listen_address(addr, o.server);
   o.server.web_root = root.empty() ? web::default_web_root() : std::filesystem::path(root);
@@ -268,7 +303,8 @@ int trace_command(const std::string& config, const GsFileConfig& file, const GsC
   return 0;
 }
 
-std::unique_ptr<DdsCommander> join_swarm(const GsFileConfig& file, bool wait_for_status, bool& ready) {
+std::unique_ptr<DdsCommander> join_swarm(const GsFileConfig& file, bool wait_for_status,
+                                         bool& ready) {
   // Give discovery a moment: the server's status is transient-local.
   // Through a discovery server, a participant that hears no server within
   // kToolRejoinAfterS (then twice as long at each try) joins again as a new
@@ -287,12 +323,14 @@ std::unique_ptr<DdsCommander> join_swarm(const GsFileConfig& file, bool wait_for
     ready = wait_for_status ? commander->wait_for_status(slice) : commander->wait_for_server(slice);
     if (ready || stop_requested() || !via_discovery_server || left - slice < 1.0) return false;
     std::fprintf(stderr,
-                 "ddswarm-gs: no server heard within %.0f s through the discovery server; joining again as a "
+                 "ddswarm-gs: no server heard within %.0f s through the discovery server; joining "
+                 "again as a "
                  "new participant\n",
                  slice);
     return true;
   });
-  if (!commander) commander = std::make_unique<DdsCommander>(file.gs, file.dds);  // stopped before joining
+  if (!commander)
+    commander = std::make_unique<DdsCommander>(file.gs, file.dds);  // stopped before joining
   return commander;
 }
 
@@ -380,7 +418,10 @@ int task_command(DdsCommander& gs, const GsFileConfig& file, const GsCommandLine
   TaskConfig t = file.task;
   if (cl.speed > 0) t.speed_mps = cl.speed;
   if (cl.epsilon > 0) t.epsilon_m = cl.epsilon;
-  auto progress = [](const std::string& p) { std::printf("  %s\n", p.c_str()); std::fflush(stdout); };
+  auto progress = [](const std::string& p) {
+    std::printf("  %s\n", p.c_str());
+    std::fflush(stdout);
+  };
   TaskOutcome o;
   if (cl.attach) {
     if (!gs.attach_task(file.gs.discovery_timeout_s)) {
@@ -432,7 +473,8 @@ int swarm_command(DdsCommander& gs, const GsCommandLine& cl) {
   if (*cl.hold) {
     double t0 = gs.status().sim_time_s;
     int rc = report(gs.hold_for(cl.hold_s));
-    if (rc == 0 && cl.wait_flag && cl.hold_s > 0) gs.wait_sim_time(t0 + cl.hold_s, cl.hold_s * 100 + 60);
+    if (rc == 0 && cl.wait_flag && cl.hold_s > 0)
+      gs.wait_sim_time(t0 + cl.hold_s, cl.hold_s * 100 + 60);
     return rc;
   }
   if (*cl.follow) return report(gs.follow_leader(cl.leader));

@@ -74,8 +74,8 @@ int compare_experiments(const std::vector<std::string>& files, std::vector<std::
                         const std::string& plot_dir, bool fail_if_different);
 
 /// `--web`: serves the live view until SIGINT/SIGTERM (docs/web_view.md).
-int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root, bool remote,
-              double upload_mb, double duration_s);
+int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root,
+              bool remote, double upload_mb, double duration_s);
 
 /// `ddswarm-gs experiment`.
 int experiment_command(const GsFileConfig& file, const GsCommandLine& cl);
@@ -89,7 +89,8 @@ void append_result(const std::string& csv, const TaskOutcome& o, int drones);
 /// Joins the swarm and waits for the server (for its status when
 /// wait_for_status), joining again through a discovery server that does not
 /// answer; ready says whether it was heard. Never null.
-std::unique_ptr<DdsCommander> join_swarm(const GsFileConfig& file, bool wait_for_status, bool& ready);
+std::unique_ptr<DdsCommander> join_swarm(const GsFileConfig& file, bool wait_for_status,
+                                         bool& ready);
 
 /// The interactive console (thesis Fig. 9) on stdin/stdout.
 int console(std::unique_ptr<DdsCommander> commander, const GsFileConfig& file);

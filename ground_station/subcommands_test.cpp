@@ -40,7 +40,8 @@ TEST(GsCommandLine, BindsEachSubcommandsOptions) {
   CLI::App app;
   GsCommandLine cl;
   add_gs_command_line(app, cl);
-  ASSERT_TRUE(parse(app, {"--config", "s.yaml", "task", "--speed", "1.2", "--csv", "r.csv", "--takeoff"}));
+  ASSERT_TRUE(
+      parse(app, {"--config", "s.yaml", "task", "--speed", "1.2", "--csv", "r.csv", "--takeoff"}));
   EXPECT_EQ(cl.config, "s.yaml");
   EXPECT_TRUE(*cl.task);
   EXPECT_FALSE(*cl.move);
@@ -114,7 +115,8 @@ TEST(CompareExperiments, SameRunsDoNotDifferAndBadArgumentsAreRefused) {
   EXPECT_NE(out.find("new against base:"), std::string::npos) << out;
   EXPECT_THROW(compare_experiments({a}, {}, "", false), FieldError);
   EXPECT_THROW(compare_experiments({a, b}, {"only one"}, "", false), FieldError);
-  EXPECT_THROW(compare_experiments({a, (dir / "missing.csv").string()}, {}, "", false), ConfigError);
+  EXPECT_THROW(compare_experiments({a, (dir / "missing.csv").string()}, {}, "", false),
+               ConfigError);
   std::filesystem::remove_all(dir);
 }
 
@@ -132,7 +134,9 @@ TEST(WaitAgents, WithNoServerTimesOutSayingWhoseViewItIs) {
   const std::string out = testing::internal::GetCapturedStdout();
   EXPECT_EQ(rc, 1);
   EXPECT_LT(took, 5.0);
-  EXPECT_EQ(out, "timed out after 0.3 s: no server heard (this ground station hears 0/0 agents online)\n");
+  EXPECT_EQ(
+      out,
+      "timed out after 0.3 s: no server heard (this ground station hears 0/0 agents online)\n");
 }
 
 // The ground station's long-running applications end on their own stop(),

@@ -96,12 +96,14 @@ void SwarmTrace::run(double duration_s) {
 }
 
 std::string SwarmSnapshot::table() const {
-  std::string out = fmt::format("tick {} (sim {:.2f} s), {} drones\n", tick, sim_time_s, drones.size());
+  std::string out =
+      fmt::format("tick {} (sim {:.2f} s), {} drones\n", tick, sim_time_s, drones.size());
   out += fmt::format("{:>5} {:>9} {:>9} {:>7} {:>7} {:>9} {:>5}  {:<9} {}\n", "drone", "x m", "y m",
                      "z m", "m/s", "nearest m", "coll", "phase", "flags");
   for (const auto& d : drones)
-    out += fmt::format("{:>5} {:>9.2f} {:>9.2f} {:>7.2f} {:>7.2f} {:>9.2f} {:>5}  {:<9} {}\n", d.id, d.x,
-                       d.y, d.z, d.speed_mps, d.nearest_peer_m, d.collisions, d.phase, d.flags);
+    out +=
+        fmt::format("{:>5} {:>9.2f} {:>9.2f} {:>7.2f} {:>7.2f} {:>9.2f} {:>5}  {:<9} {}\n", d.id,
+                    d.x, d.y, d.z, d.speed_mps, d.nearest_peer_m, d.collisions, d.phase, d.flags);
   out += fmt::format("pairwise distance: min {:.2f} m, max {:.2f} m\n", min_pair_m, max_pair_m);
   return out;
 }
@@ -132,7 +134,8 @@ SwarmSnapshot snapshot_of(const msg::SwarmState& s) {
       }
     }
     if (pos.size() < 2) r.nearest_peer_m = 0;
-    r.collisions = static_cast<int>(d.collisions_obstacle() + d.collisions_drone() + d.collisions_ground());
+    r.collisions =
+        static_cast<int>(d.collisions_obstacle() + d.collisions_drone() + d.collisions_ground());
     r.phase = to_string(static_cast<Phase>(d.phase()));
     auto flag = [&](std::uint16_t bit, const char* name) {
       if (d.flags() & bit) r.flags += (r.flags.empty() ? "" : ",") + std::string(name);
@@ -141,7 +144,8 @@ SwarmSnapshot snapshot_of(const msg::SwarmState& s) {
     flag(msg::DRONE_FAILSAFE, "failsafe");
     flag(msg::DRONE_OUT_OF_BOUNDS, "out-of-bounds");
     flag(msg::DRONE_PAST_FINISH, "past-finish");
-    if (!(d.flags() & msg::DRONE_AGENT_LIVE)) r.flags += (r.flags.empty() ? "" : ",") + std::string("no-agent");
+    if (!(d.flags() & msg::DRONE_AGENT_LIVE))
+      r.flags += (r.flags.empty() ? "" : ",") + std::string("no-agent");
     snap.drones.push_back(r);
   }
   return snap;

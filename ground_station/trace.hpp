@@ -1,9 +1,9 @@
 #pragma once
 // Writes the swarm's state to CSV as it flies: one row per drone per traced
 // tick, and, with a metrics file, one row of swarm metrics per traced tick.
+#include <cstdint>
 #include <cstdio>
 #include <memory>
-#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,20 +49,20 @@ class SwarmTrace {
 /// One drone at one tick, as the ground station sees it.
 struct DroneRow {
   int id = 0;
-  double x = 0, y = 0, z = 0;   ///< m, ENU
+  double x = 0, y = 0, z = 0;  ///< m, ENU
   double speed_mps = 0;
-  double nearest_peer_m = 0;    ///< m, distance to the nearest other drone
+  double nearest_peer_m = 0;  ///< m, distance to the nearest other drone
   int collisions = 0;
   std::string phase;
-  std::string flags;            ///< "airborne", "failsafe", "no-agent", ...
+  std::string flags;  ///< "airborne", "failsafe", "no-agent", ...
 };
 
 struct SwarmSnapshot {
   std::uint64_t tick = 0;
   double sim_time_s = 0;
   std::vector<DroneRow> drones;
-  double min_pair_m = 0;  ///< m, smallest pairwise distance
-  double max_pair_m = 0;  ///< m, largest pairwise distance (the swarm's size, Eq. 3.1)
+  double min_pair_m = 0;      ///< m, smallest pairwise distance
+  double max_pair_m = 0;      ///< m, largest pairwise distance (the swarm's size, Eq. 3.1)
   std::string table() const;  ///< a per-drone table plus a summary line
 };
 

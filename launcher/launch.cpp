@@ -47,12 +47,15 @@ std::vector<std::string> words(const std::string& s) {
 void add_launch_command_line(CLI::App& app, LaunchCommandLine& cl) {
   app.add_option("scenario", cl.scenario, "scenario YAML")->required();
   app.add_option("--drones", cl.drones, "number of drones (overrides the scenario)");
-  app.add_option("--mode", cl.mode, "lockstep | realtime")->check(CLI::IsMember({"lockstep", "realtime"}));
+  app.add_option("--mode", cl.mode, "lockstep | realtime")
+      ->check(CLI::IsMember({"lockstep", "realtime"}));
   app.add_option("--seed", cl.seed, "scenario seed");
-  app.add_option("--only", cl.only, "start only: server | agents | all")->check(CLI::IsMember({"server", "agents", "all"}));
+  app.add_option("--only", cl.only, "start only: server | agents | all")
+      ->check(CLI::IsMember({"server", "agents", "all"}));
   app.add_option("--ids", cl.ids_text, "agents to start, e.g. 3-5,7 (default: all)");
   app.add_option("--agent-hosts", cl.agent_hosts,
-                 "fly the agents in K agent-host processes (ddswarm-agent --ids) instead of one process per drone")
+                 "fly the agents in K agent-host processes (ddswarm-agent --ids) instead of one "
+                 "process per drone")
       ->check(CLI::Range(1, 1024));
   app.add_option("--on-death", cl.on_death,
                  "when a process dies: stop (stop everything, exit 1) | keep (report, keep "
@@ -65,19 +68,22 @@ void add_launch_command_line(CLI::App& app, LaunchCommandLine& cl) {
       "1.5 agent.rejoin_after_s, 90 s by default), e.g. \"takeoff --wait; task\"; "
       "everything stops when they finish");
   app.add_flag("--gs-interactive", cl.gs_interactive, "open the ground-station console here");
-  app.add_option("--log-dir", cl.log_dir, "write each process's log to DIR/<name>.log instead of the terminal");
+  app.add_option("--log-dir", cl.log_dir,
+                 "write each process's log to DIR/<name>.log instead of the terminal");
   app.add_option("--duration", cl.duration_s, "stop everything after this many wall seconds")
       ->check(finite_range(0.0, 1e9));
   app.add_option("--record", cl.record_dir, "record the run's DDS traffic to DIR/run-<time>.mcap");
-  app.add_option("--set", cl.sets,
-                 "override a scenario key for this run, e.g. --set comm.latency_s=0.3 (repeatable)");
+  app.add_option(
+      "--set", cl.sets,
+      "override a scenario key for this run, e.g. --set comm.latency_s=0.3 (repeatable)");
   add_dds_options(app, cl.dds_cli);
   // The launcher's own --discovery-server: it may run the server itself.
   app.remove_option(app.get_option("--discovery-server"));
-  app.add_option("--discovery-server", cl.ds_text,
-                 fmt::format("Fast DDS discovery server: auto (start one on 127.0.0.1 above {} drones), "
-                             "on (always start one), off, or IP:PORT of a running one",
-                             kAutoDiscoveryServerAbove))
+  app.add_option(
+         "--discovery-server", cl.ds_text,
+         fmt::format("Fast DDS discovery server: auto (start one on 127.0.0.1 above {} drones), "
+                     "on (always start one), off, or IP:PORT of a running one",
+                     kAutoDiscoveryServerAbove))
       ->group("Networking (default: this machine only)");
 }
 
@@ -104,8 +110,9 @@ LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl) : cl_(std::move(
     derive(parse_set_options(cl_.sets), "--set overrides");
   }
   if (app.count("--participant-id"))
-    throw FieldError("--participant-id", app.get_option("--participant-id")->as<std::string>(),
-                     "names one process; the launcher starts many (see docs/networking.md, large swarms)");
+    throw FieldError(
+        "--participant-id", app.get_option("--participant-id")->as<std::string>(),
+        "names one process; the launcher starts many (see docs/networking.md, large swarms)");
   auto file = load_gs_config(cl_.scenario);
   file_dds_ = file.dds;
   // A launch that runs a server owns its domain on this host while it runs:
@@ -116,9 +123,10 @@ LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl) : cl_(std::move(
   if (cl_.only != "agents") {
     claim_.emplace(dds_.domain_id);
     if (!claim_->held())
-      throw FieldError(app.count("--domain") ? "--domain" : "dds.domain_id", std::to_string(dds_.domain_id),
-                       "claimed on this host by " + claim_->holder() +
-                           "; two swarms on one domain take each other's commands, so choose another");
+      throw FieldError(
+          app.count("--domain") ? "--domain" : "dds.domain_id", std::to_string(dds_.domain_id),
+          "claimed on this host by " + claim_->holder() +
+              "; two swarms on one domain take each other's commands, so choose another");
   }
   n_ = cl_.drones.value_or(file.drones);
   if (n_ < 1 || n_ > 1024) throw FieldError("--drones", std::to_string(n_), "must be in [1, 1024]");
@@ -147,8 +155,8 @@ LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl) : cl_(std::move(
     dds_args_.push_back("--discovery-server");
     dds_args_.push_back(ds_.address);
   }
-  for (const char* opt : {"--domain", "--dds-interface", "--dds-local-ip",
-                          "--dds-profiles", "--dds-peers", "--secure"}) {
+  for (const char* opt : {"--domain", "--dds-interface", "--dds-local-ip", "--dds-profiles",
+                          "--dds-peers", "--secure"}) {
     if (app.count(opt)) {
       auto* o = app.get_option(opt);
       dds_args_.push_back(opt);
@@ -159,9 +167,10 @@ LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl) : cl_(std::move(
   }
   // Its value, not just the flag: --best-effort-streams=false must reach the children as false.
   if (app.count("--best-effort-streams"))
-    dds_args_.push_back(std::string("--best-effort-streams=") + (cl_.dds_cli.best_effort_streams ? "true" : "false"));
-  localhost_discovery_ = file_dds_.discovery == Discovery::kLocalhost && !app.count("--dds-interface") &&
-                         !app.count("--dds-peers");
+    dds_args_.push_back(std::string("--best-effort-streams=") +
+                        (cl_.dds_cli.best_effort_streams ? "true" : "false"));
+  localhost_discovery_ = file_dds_.discovery == Discovery::kLocalhost &&
+                         !app.count("--dds-interface") && !app.count("--dds-peers");
   // The whole swarm with its server (not --ids, --only): agent_command's
   // agents skip their duplicate probe.
   whole_swarm_ = cl_.only == "all" && cl_.ids_text.empty();
@@ -172,10 +181,12 @@ bool LaunchApp::stopping() const { return stop_ || stop_requested(); }
 
 void LaunchApp::derive(const std::map<std::string, YAML::Node>& overrides, const std::string& why) {
   YAML::Node derived = apply_overrides(YamlDocument::load_file(cl_.scenario).root(), overrides);
-  const std::string dir = cl_.log_dir.empty() ? std::filesystem::temp_directory_path().string() : cl_.log_dir;
+  const std::string dir =
+      cl_.log_dir.empty() ? std::filesystem::temp_directory_path().string() : cl_.log_dir;
   std::filesystem::create_directories(dir);
   const std::string path = dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
-  std::ofstream(path) << "# " << cl_.scenario << " with " << why << "\n" << YAML::Dump(derived) << "\n";
+  std::ofstream(path) << "# " << cl_.scenario << " with " << why << "\n"
+                      << YAML::Dump(derived) << "\n";
   std::cerr << "ddswarm-launch: scenario with " << why << " written to " << path << "\n";
   cl_.scenario = path;
 }
@@ -186,7 +197,8 @@ int LaunchApp::run() {
   // What discovery scales with is participants: with agent hosts, a few.
   const int participants = cl_.agent_hosts > 0 ? std::min<int>(cl_.agent_hosts, n_) + 1 : n_;
   // Not under DDS Security: Fast DDS 2.9's discovery server has none.
-  if (wants_local_discovery_server(ds_, participants, whole_swarm_, localhost_discovery_ && !dds_.secure()))
+  if (wants_local_discovery_server(ds_, participants, whole_swarm_,
+                                   localhost_discovery_ && !dds_.secure()))
     start_discovery_server();
   if (!cl_.record_dir.empty()) start_recorder();
   if (cl_.only != "agents") start_server();
@@ -229,8 +241,7 @@ void LaunchApp::start_discovery_server() {
   const YAML::Node root = YamlDocument::load_file(cl_.scenario).root();
   std::map<std::string, YAML::Node> for_ds;
   auto unless_named = [&](const char* section, const char* key, const YAML::Node& value) {
-    if (!(root[section] && root[section][key]))
-      for_ds[fmt::format("{}.{}", section, key)] = value;
+    if (!(root[section] && root[section][key])) for_ds[fmt::format("{}.{}", section, key)] = value;
   };
   unless_named("dds", "lease_duration_s", YAML::Node(kDiscoveryServerLeaseS));
   unless_named("dds", "shm_transport", YAML::Node(false));
@@ -260,7 +271,8 @@ void LaunchApp::start_recorder() {
 }
 
 void LaunchApp::start_server() {
-  std::vector<std::string> a = {bin_ + "/ddswarm-sim", "--scenario", cl_.scenario, "--drones", std::to_string(n_)};
+  std::vector<std::string> a = {bin_ + "/ddswarm-sim", "--scenario", cl_.scenario, "--drones",
+                                std::to_string(n_)};
   if (cl_.mode) {
     a.push_back("--mode");
     a.push_back(*cl_.mode);
@@ -276,10 +288,11 @@ void LaunchApp::start_server() {
 void LaunchApp::warn_about_participant_ids() {
   if (cl_.agent_hosts == 0 && !ids_.empty() && agent_participant_id(n_, ids_.back()) < 0 &&
       n_ > kExplicitParticipantIdsAbove)
-    std::cerr << fmt::format("ddswarm-launch: warning: {} drones: agents past drone {} get automatic participant "
-                             "ids, and past ~100 participants per host Fast DDS leaves them unreachable "
-                             "(dds.participant_id stops at {}; docs/performance.md)\n",
-                             n_, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
+    std::cerr << fmt::format(
+        "ddswarm-launch: warning: {} drones: agents past drone {} get automatic participant "
+        "ids, and past ~100 participants per host Fast DDS leaves them unreachable "
+        "(dds.participant_id stops at {}; docs/performance.md)\n",
+        n_, kMaxParticipantId - kFirstAgentParticipantId, kMaxParticipantId);
   if (cl_.agent_hosts == 0 && !ids_.empty() && agent_participant_id(n_, ids_.front()) >= 0) {
     const std::string w =
         ephemeral_port_warning(dds_.domain_id, agent_participant_id(n_, ids_.front()),
@@ -336,8 +349,8 @@ std::vector<std::string> LaunchApp::gs_argv(const std::vector<std::string>& sub)
 int LaunchApp::supervise() {
   int rc = 0;
   if (!cl_.gs_script.empty()) {
-    std::vector<std::string> steps = {fmt::format("wait-agents --count {} --timeout {:g}", ids_.size(),
-                                                  agents_wait_s(cl_.scenario))};
+    std::vector<std::string> steps = {fmt::format("wait-agents --count {} --timeout {:g}",
+                                                  ids_.size(), agents_wait_s(cl_.scenario))};
     for (const auto& s : split_script(cl_.gs_script)) steps.push_back(s);
     for (const auto& step : steps) {
       if (stopping() || death_policy_->stop()) break;

@@ -3,8 +3,8 @@
 // and LaunchApp, which starts the server and one agent process per drone (and
 // optionally ground-station commands), prefixes their logs and supervises
 // them until they end, --duration passes, a signal or stop().
-#include <CLI/CLI.hpp>
 #include <yaml-cpp/yaml.h>
+#include <CLI/CLI.hpp>
 
 #include <atomic>
 #include <cstdint>

@@ -62,8 +62,8 @@ TEST(LaunchApp, StopEndsTheRunAndStopsItsProcesses) {
   // One agent, on a domain of its own: it waits for a server that never comes.
   const auto dir = temp_dir("stop");
   const int domain = 100 + static_cast<int>(random_instance() % 20);
-  auto launch = build({kScenario, "--only", "agents", "--ids", "0", "--domain", std::to_string(domain),
-                       "--log-dir", dir.string()});
+  auto launch = build({kScenario, "--only", "agents", "--ids", "0", "--domain",
+                       std::to_string(domain), "--log-dir", dir.string()});
   std::thread stopper([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(1500));
     launch->stop();

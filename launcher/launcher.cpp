@@ -162,29 +162,32 @@ void Launcher::rejoin_dropped_participants(const std::string& ds_name) {
 
 void Launcher::on_dropped(const std::array<std::uint8_t, 12>& prefix, bool server_only) {
   const int pid16 = prefix_pid16(prefix);
-  const auto it = std::find_if(live_.begin(), live_.end(), [&](const auto& kv) { return (kv.first & 0xffff) == pid16; });
+  const auto it = std::find_if(live_.begin(), live_.end(),
+                               [&](const auto& kv) { return (kv.first & 0xffff) == pid16; });
   const Child* c = it == live_.end() ? nullptr : it->second.get();
   if (server_only && !(c && c->name == "sim")) return;
   if (!dropped_seen_.insert(prefix).second) return;  // one participant: several endpoint lines
   std::string guid;
   for (auto b : prefix) guid += fmt::format("{}{:02x}", guid.empty() ? "" : ".", b);
   if (!c) {  // a tool that joined by itself: it says so when it finds no server
-    std::cerr << "ddswarm-launch: the discovery server dropped the endpoints of participant " << guid
-              << ", not one of this launch's processes\n";
+    std::cerr << "ddswarm-launch: the discovery server dropped the endpoints of participant "
+              << guid << ", not one of this launch's processes\n";
   } else if (c->name.rfind("agent", 0) == 0 || c->name == "sim") {
-    std::cerr << "ddswarm-launch: the discovery server dropped " << c->name << "'s endpoints (participant " << guid
-              << "); asking it to join again\n";
+    std::cerr << "ddswarm-launch: the discovery server dropped " << c->name
+              << "'s endpoints (participant " << guid << "); asking it to join again\n";
     kill(c->pid, SIGUSR1);
   } else {
-    std::cerr << "ddswarm-launch: warning: the discovery server dropped " << c->name << "'s endpoints (participant "
-              << guid << "); Fast DDS 2.9 never matches them afterwards\n";
+    std::cerr << "ddswarm-launch: warning: the discovery server dropped " << c->name
+              << "'s endpoints (participant " << guid
+              << "); Fast DDS 2.9 never matches them afterwards\n";
   }
 }
 
 void Launcher::emit(Child& c, const char* data, std::size_t n, bool flush) {
   c.partial.append(data, n);
   std::size_t start = 0, nl;
-  while ((nl = c.partial.find('\n', start)) != std::string::npos || (flush && start < c.partial.size())) {
+  while ((nl = c.partial.find('\n', start)) != std::string::npos ||
+         (flush && start < c.partial.size())) {
     std::size_t end = nl == std::string::npos ? c.partial.size() : nl;
     std::string line = c.partial.substr(start, end - start);
     if (!drop_watch_.empty() && c.name == drop_watch_) {
@@ -263,7 +266,8 @@ std::vector<ChildExit> Launcher::reap() {
         int flags = fcntl(it->second->out_fd, F_GETFL);
         fcntl(it->second->out_fd, F_SETFL, flags | O_NONBLOCK);
         ssize_t n;
-        while ((n = read(it->second->out_fd, buf, sizeof buf)) > 0) emit(*it->second, buf, n, false);
+        while ((n = read(it->second->out_fd, buf, sizeof buf)) > 0)
+          emit(*it->second, buf, n, false);
         emit(*it->second, "", 0, true);
         close(it->second->out_fd);
         it->second->out_fd = -1;
@@ -330,19 +334,22 @@ DiscoveryServerChoice parse_discovery_server(const std::string& text) {
                  text.size() - colon - 1 <= 5 && std::stoi(text.substr(colon + 1)) > 0 &&
                  std::stoi(text.substr(colon + 1)) < 65536;
   if (inet_pton(AF_INET, host.c_str(), &a) != 1 || !port_ok)
-    throw std::invalid_argument("--discovery-server " + text + ": must be auto, on, off or IPv4:port");
+    throw std::invalid_argument("--discovery-server " + text +
+                                ": must be auto, on, off or IPv4:port");
   c.kind = DiscoveryServerChoice::Kind::kExternal;
   c.address = text;
   return c;
 }
 
-bool wants_local_discovery_server(const DiscoveryServerChoice& c, int drones, bool starts_whole_swarm,
-                                  bool localhost_discovery) {
+bool wants_local_discovery_server(const DiscoveryServerChoice& c, int drones,
+                                  bool starts_whole_swarm, bool localhost_discovery) {
   switch (c.kind) {
-    case DiscoveryServerChoice::Kind::kOn: return true;
+    case DiscoveryServerChoice::Kind::kOn:
+      return true;
     case DiscoveryServerChoice::Kind::kAuto:
       return drones > kAutoDiscoveryServerAbove && starts_whole_swarm && localhost_discovery;
-    default: return false;
+    default:
+      return false;
   }
 }
 
@@ -405,13 +412,16 @@ std::vector<std::string> agent_command(const std::string& bin, const std::string
 
 std::string ephemeral_port_warning(int domain, int first_id, int last_id, PortRange ephemeral) {
   const auto [lo, hi] = ephemeral;
-  const int low = rtps_unicast_port(domain, first_id), high = rtps_unicast_port(domain, last_id) + 1;
+  const int low = rtps_unicast_port(domain, first_id),
+            high = rtps_unicast_port(domain, last_id) + 1;
   if (first_id < 0 || last_id < first_id || high < lo || low > hi) return "";
-  const int clear_domain = (lo - 1 - rtps_unicast_port(0, last_id) - 1) / 250;  // largest d with every port below lo
-  return fmt::format("participant ids {}-{} in domain {} use RTPS ports {}-{}, inside this machine's ephemeral "
-                     "port range {}-{}: a participant whose port another socket holds is never discovered; "
-                     "use --domain {} or lower",
-                     first_id, last_id, domain, low, high, lo, hi, std::max(0, clear_domain));
+  const int clear_domain =
+      (lo - 1 - rtps_unicast_port(0, last_id) - 1) / 250;  // largest d with every port below lo
+  return fmt::format(
+      "participant ids {}-{} in domain {} use RTPS ports {}-{}, inside this machine's ephemeral "
+      "port range {}-{}: a participant whose port another socket holds is never discovered; "
+      "use --domain {} or lower",
+      first_id, last_id, domain, low, high, lo, hi, std::max(0, clear_domain));
 }
 
 ChildSpec discovery_server_spec(int port) {
@@ -420,10 +430,12 @@ ChildSpec discovery_server_spec(int port) {
   std::stringstream dirs(path ? path : "/usr/bin:/bin");
   std::string dir;
   while (exe.empty() && std::getline(dirs, dir, ':'))
-    if (access((dir + "/fast-discovery-server").c_str(), X_OK) == 0) exe = dir + "/fast-discovery-server";
+    if (access((dir + "/fast-discovery-server").c_str(), X_OK) == 0)
+      exe = dir + "/fast-discovery-server";
   if (exe.empty())
     throw std::runtime_error(
-        "fast-discovery-server not found (Debian package fastdds-tools; ./scripts/setup installs it)");
+        "fast-discovery-server not found (Debian package fastdds-tools; ./scripts/setup installs "
+        "it)");
   return {"discovery-server",
           {exe, "-i", "0", "-l", "127.0.0.1", "-p", std::to_string(port), "-x",
            std::string(DDSWARM_CONFIG_DIR) + "/discovery_server.xml"}};
@@ -448,8 +460,8 @@ std::optional<std::array<std::uint8_t, 12>> prefix_before_bar(const std::string&
   std::array<std::uint8_t, 12> out{};
   for (int k = 0; k < 12; ++k) {
     const std::string byte = guid.substr(3 * k, 2);
-    if (!std::isxdigit(static_cast<unsigned char>(byte[0])) || !std::isxdigit(static_cast<unsigned char>(byte[1])) ||
-        (k < 11 && guid[3 * k + 2] != '.'))
+    if (!std::isxdigit(static_cast<unsigned char>(byte[0])) ||
+        !std::isxdigit(static_cast<unsigned char>(byte[1])) || (k < 11 && guid[3 * k + 2] != '.'))
       return std::nullopt;
     out[k] = static_cast<std::uint8_t>(std::stoi(byte, nullptr, 16));
   }
@@ -467,7 +479,9 @@ std::optional<std::array<std::uint8_t, 12>> unmatched_participant_prefix(const s
   return prefix_before_bar(line);
 }
 
-int prefix_pid16(const std::array<std::uint8_t, 12>& prefix) { return prefix[4] | (prefix[5] << 8); }
+int prefix_pid16(const std::array<std::uint8_t, 12>& prefix) {
+  return prefix[4] | (prefix[5] << 8);
+}
 
 int free_udp_port() {
   int s = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);

@@ -29,9 +29,10 @@ struct ChildSpec {
 struct ChildExit {
   std::string name;
   pid_t pid = 0;
-  int exit_code = -1;   ///< when it exited
-  int signal = 0;       ///< when a signal killed it
-  std::string describe() const;  ///< "agent 3 (pid 1234) exited with code 1" / "was killed by SIGKILL"
+  int exit_code = -1;  ///< when it exited
+  int signal = 0;      ///< when a signal killed it
+  std::string describe()
+      const;  ///< "agent 3 (pid 1234) exited with code 1" / "was killed by SIGKILL"
 };
 
 /// --on-death restart: whether an agent's end is one that starting it again
@@ -131,7 +132,7 @@ class Launcher {
   /// mu_ held. server_only: act only when the participant is the server's.
   void on_dropped(const std::array<std::uint8_t, 12>& prefix, bool server_only);
 
-  std::string drop_watch_;                              ///< rejoin_dropped_participants
+  std::string drop_watch_;                               ///< rejoin_dropped_participants
   std::set<std::array<std::uint8_t, 12>> dropped_seen_;  ///< participants already acted on
 
   std::string log_dir_;
@@ -178,7 +179,8 @@ constexpr int kAutoDiscoveryServerAbove = 32;
 /// server. 32 leaves room for them all.
 constexpr int kExplicitParticipantIdsAbove = 90;
 constexpr int kFirstAgentParticipantId = kAgentParticipantIdBase;  // common/dds_config.hpp
-constexpr int kMaxParticipantId = 1100;  ///< 1024 drones and then some; dds.participant_id also bounds it by domain (common/dds_config)
+constexpr int kMaxParticipantId = 1100;  ///< 1024 drones and then some; dds.participant_id also
+                                         ///< bounds it by domain (common/dds_config)
 
 /// The RTPS participant id the launcher gives drone_id's agent in a swarm of
 /// `drones`, or -1 for Fast DDS's automatic one.
@@ -212,8 +214,8 @@ std::string ephemeral_port_warning(int domain, int first_id, int last_id, PortRa
 /// True when the launcher should start its own server. `starts_whole_swarm`:
 /// it starts the server and every agent (a local server cannot serve a swarm
 /// split across hosts); `localhost_discovery`: no other network was opted into.
-bool wants_local_discovery_server(const DiscoveryServerChoice& c, int drones, bool starts_whole_swarm,
-                                  bool localhost_discovery);
+bool wants_local_discovery_server(const DiscoveryServerChoice& c, int drones,
+                                  bool starts_whole_swarm, bool localhost_discovery);
 
 /// fast-discovery-server on 127.0.0.1:port only (config/discovery_server.xml
 /// keeps its transports off every other interface). Throws std::runtime_error

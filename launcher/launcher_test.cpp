@@ -51,7 +51,8 @@ TEST(Launcher, RunToEndCollectsOutputAndExitCode) {
 TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
   // As fast-discovery-server 2.9 prints its errors, colours and all.
   auto logged = [](const std::string& message, const std::string& function) {
-    return "\x1b[37;1m2026-11-21 21:17:38.547 \x1b[31;1m[\x1b[37;1mDISCOVERY_DATABASE\x1b[31;1m Error] \x1b[37m" +
+    return "\x1b[37;1m2026-11-21 21:17:38.547 \x1b[31;1m[\x1b[37;1mDISCOVERY_DATABASE\x1b[31;1m "
+           "Error] \x1b[37m" +
            message + "\x1b[34;1m -> Function \x1b[36m" + function + "\x1b[m";
   };
   const std::string line = logged(
@@ -59,14 +60,18 @@ TEST(Launcher, ReadsTheDiscoveryServersDroppedParticipants) {
       "create_writers_from_change_");
   auto p = dropped_participant_prefix(line);
   ASSERT_TRUE(p);
-  const std::array<std::uint8_t, 12> want = {0x01, 0x0f, 0x78, 0xfd, 0x33, 0x40, 0xd6, 0x23, 0x25, 0, 0, 0};
+  const std::array<std::uint8_t, 12> want = {0x01, 0x0f, 0x78, 0xfd, 0x33, 0x40,
+                                             0xd6, 0x23, 0x25, 0,    0,    0};
   EXPECT_EQ(*p, want);
   EXPECT_EQ(prefix_pid16(*p), 16435);  // the agent's pid in that run, 0x4033
-  EXPECT_FALSE(dropped_participant_prefix("Attempting to delete and orphan reader -> Function delete_reader_entity_"));
+  EXPECT_FALSE(dropped_participant_prefix(
+      "Attempting to delete and orphan reader -> Function delete_reader_entity_"));
   EXPECT_FALSE(dropped_participant_prefix("### Server is running ###"));
-  EXPECT_FALSE(dropped_participant_prefix("Writer 01.0f.zz|0.0.1.2 has no associated participant. Skipping"));
+  EXPECT_FALSE(dropped_participant_prefix(
+      "Writer 01.0f.zz|0.0.1.2 has no associated participant. Skipping"));
   const std::string unmatched = logged(
-      "Matching unexisting participant from writer 01.0f.78.fd.b5.74.d4.24.00.00.00.00|0.0.1.3", "match_writer_reader_");
+      "Matching unexisting participant from writer 01.0f.78.fd.b5.74.d4.24.00.00.00.00|0.0.1.3",
+      "match_writer_reader_");
   auto u = unmatched_participant_prefix(unmatched);
   ASSERT_TRUE(u);
   EXPECT_EQ(prefix_pid16(*u), 0x74b5);
@@ -79,8 +84,9 @@ TEST(Launcher, AsksAnAgentWhoseEndpointsTheDiscoveryServerDroppedToJoinAgain) {
   l.rejoin_dropped_participants("discovery-server");
   // Children that exit with a code of their own on SIGUSR1.
   auto on_usr1 = [](int code) {
-    return std::vector<std::string>{"/bin/sh", "-c",
-                                    "trap 'exit " + std::to_string(code) + "' USR1; while :; do sleep 0.05; done"};
+    return std::vector<std::string>{
+        "/bin/sh", "-c",
+        "trap 'exit " + std::to_string(code) + "' USR1; while :; do sleep 0.05; done"};
   };
   const pid_t agent5 = l.start({"agent 5", on_usr1(42)});
   const pid_t agent6 = l.start({"agent 6", on_usr1(43)});
@@ -88,18 +94,23 @@ TEST(Launcher, AsksAnAgentWhoseEndpointsTheDiscoveryServerDroppedToJoinAgain) {
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // all have their traps
   auto guid = [](pid_t pid) {
     char g[64];
-    std::snprintf(g, sizeof g, "01.0f.78.fd.%02x.%02x.d6.23.25.00.00.00", pid & 0xff, (pid >> 8) & 0xff);
+    std::snprintf(g, sizeof g, "01.0f.78.fd.%02x.%02x.d6.23.25.00.00.00", pid & 0xff,
+                  (pid >> 8) & 0xff);
     return std::string(g);
   };
   // Agent 5's endpoints dropped (twice: one signal); "Matching unexisting
   // participant" for agent 6, which may just have left: no signal; for the
   // server, which never leaves by itself: a signal.
-  const std::string dropped = "Writer " + guid(agent5) + "|0.0.1.2 has no associated participant. Skipping";
-  const std::string unmatched6 = "Matching unexisting participant from writer " + guid(agent6) + "|0.0.1.3";
-  const std::string unmatched_sim = "Matching unexisting participant from reader " + guid(sim) + "|0.0.4.7";
-  l.start({"discovery-server", {"/bin/sh", "-c",
-                                "echo '" + dropped + "'; echo '" + dropped + "'; echo '" + unmatched6 + "'; echo '" +
-                                    unmatched_sim + "'; sleep 30"}});
+  const std::string dropped =
+      "Writer " + guid(agent5) + "|0.0.1.2 has no associated participant. Skipping";
+  const std::string unmatched6 =
+      "Matching unexisting participant from writer " + guid(agent6) + "|0.0.1.3";
+  const std::string unmatched_sim =
+      "Matching unexisting participant from reader " + guid(sim) + "|0.0.4.7";
+  l.start({"discovery-server",
+           {"/bin/sh", "-c",
+            "echo '" + dropped + "'; echo '" + dropped + "'; echo '" + unmatched6 + "'; echo '" +
+                unmatched_sim + "'; sleep 30"}});
   std::map<pid_t, int> codes;
   for (int i = 0; i < 150 && codes.size() < 2; ++i) {
     for (const auto& e : l.reap()) codes[e.pid] = e.exit_code;
@@ -118,7 +129,8 @@ TEST(Launcher, StopAllLeavesNoChildBehind) {
   std::vector<pid_t> pids;
   {
     Launcher l;
-    for (int i = 0; i < 4; ++i) pids.push_back(l.start({"s" + std::to_string(i), {"/bin/sleep", "30"}}));
+    for (int i = 0; i < 4; ++i)
+      pids.push_back(l.start({"s" + std::to_string(i), {"/bin/sleep", "30"}}));
     // One child ignores SIGTERM: stop_all must still end it.
     pids.push_back(l.start({"stubborn", {"/bin/sh", "-c", "trap '' TERM; sleep 30"}}));
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -140,10 +152,11 @@ TEST(Launcher, AgentHostSharesSplitTheIdsContiguously) {
   using V = std::vector<std::string>;
   EXPECT_EQ(agent_host_shares({0, 1, 2, 3, 4, 5}, 2), (V{"0,1,2", "3,4,5"}));
   EXPECT_EQ(agent_host_shares({0, 1, 2, 3, 4}, 2), (V{"0,1,2", "3,4"}));
-  EXPECT_EQ(agent_host_shares({3, 4, 5, 7}, 3), (V{"3,4", "5,7"}));  // ceil(4/3) = 2 per host: two hosts
-  EXPECT_EQ(agent_host_shares({0, 1}, 5), (V{"0", "1"}));             // never an empty host
+  EXPECT_EQ(agent_host_shares({3, 4, 5, 7}, 3),
+            (V{"3,4", "5,7"}));                            // ceil(4/3) = 2 per host: two hosts
+  EXPECT_EQ(agent_host_shares({0, 1}, 5), (V{"0", "1"}));  // never an empty host
   EXPECT_EQ(agent_host_shares({0, 1, 2}, 1), (V{"0,1,2"}));
-  EXPECT_TRUE(agent_host_shares({0, 1, 2}, 0).empty());               // 0: one process per drone
+  EXPECT_TRUE(agent_host_shares({0, 1, 2}, 0).empty());  // 0: one process per drone
   EXPECT_TRUE(agent_host_shares({}, 2).empty());
 }
 
@@ -159,8 +172,8 @@ TEST(Launcher, RestartsOnlyWhatStartingAgainCanMend) {
   const auto exit_with = [](int code) { return ChildExit{"agent 2", 42, code, 0}; };
   EXPECT_TRUE(worth_restarting(ChildExit{"agent 2", 42, -1, SIGABRT}));  // a crash
   EXPECT_TRUE(worth_restarting(ChildExit{"agent 2", 42, -1, SIGKILL}));  // an OOM kill, a user
-  EXPECT_TRUE(worth_restarting(exit_with(1)));                            // an error at run time
-  EXPECT_FALSE(worth_restarting(exit_with(0)));  // its --duration ended
+  EXPECT_TRUE(worth_restarting(exit_with(1)));                           // an error at run time
+  EXPECT_FALSE(worth_restarting(exit_with(0)));                          // its --duration ended
   EXPECT_FALSE(worth_restarting(exit_with(2)));  // its configuration: it would fail again
   EXPECT_FALSE(worth_restarting(exit_with(3)));  // another agent flies its drone
 }
@@ -263,7 +276,8 @@ TEST(Launcher, DiscoveryServerChoice) {
   auto ext = parse_discovery_server("10.0.0.2:11811");
   EXPECT_EQ(ext.kind, K::kExternal);
   EXPECT_EQ(ext.address, "10.0.0.2:11811");
-  for (const char* bad : {"", "yes", "10.0.0.2", "10.0.0.2:", "10.0.0.2:x", "10.0.0.2:70000", "host:11811"})
+  for (const char* bad :
+       {"", "yes", "10.0.0.2", "10.0.0.2:", "10.0.0.2:x", "10.0.0.2:70000", "host:11811"})
     EXPECT_THROW(parse_discovery_server(bad), std::invalid_argument) << bad;
   // auto: only a large swarm whose every process this launcher starts on this machine.
   const auto a = parse_discovery_server("auto");

@@ -33,7 +33,7 @@ struct Column {
   int width = 1;  ///< components per value: 3 for a Vec3, 4 for a Quat or float[4]
   int depth = 0;  ///< sequences around the value
   std::array<std::size_t, 2> extent{0, 0};  ///< the longest sequence at each depth
-  py::object array;  ///< numpy array, or a list of str
+  py::object array;                         ///< numpy array, or a list of str
   void* data = nullptr;
 };
 
@@ -49,29 +49,39 @@ class Columns {
   template <class T>
   void value(const char* name, const T& x) {
     if constexpr (std::is_same_v<T, bool>)
-      put(name, Kind::kBool, 1, [&](Column& c, std::size_t o) { static_cast<bool*>(c.data)[o] = x; });
+      put(name, Kind::kBool, 1,
+          [&](Column& c, std::size_t o) { static_cast<bool*>(c.data)[o] = x; });
     else if constexpr (std::is_integral_v<T> && sizeof(T) == 8 && std::is_unsigned_v<T>)
-      put(name, Kind::kU64, 1, [&](Column& c, std::size_t o) { static_cast<std::uint64_t*>(c.data)[o] = x; });
+      put(name, Kind::kU64, 1,
+          [&](Column& c, std::size_t o) { static_cast<std::uint64_t*>(c.data)[o] = x; });
     else if constexpr (std::is_integral_v<T> && sizeof(T) == 8)
-      put(name, Kind::kI64, 1, [&](Column& c, std::size_t o) { static_cast<std::int64_t*>(c.data)[o] = x; });
+      put(name, Kind::kI64, 1,
+          [&](Column& c, std::size_t o) { static_cast<std::int64_t*>(c.data)[o] = x; });
     else
-      put(name, Kind::kFloat, 1, [&](Column& c, std::size_t o) { static_cast<double*>(c.data)[o] = static_cast<double>(x); });
+      put(name, Kind::kFloat, 1, [&](Column& c, std::size_t o) {
+        static_cast<double*>(c.data)[o] = static_cast<double>(x);
+      });
   }
   template <class S>
   void text(const char* name, const S& s) {
     put(name, Kind::kText, 1, [&](Column& c, std::size_t) {
       std::string t;
-      if constexpr (std::is_same_v<S, std::string>) t = s;
-      else t = s.to_string();
+      if constexpr (std::is_same_v<S, std::string>)
+        t = s;
+      else
+        t = s.to_string();
       py::list l = c.array;
-      if (c.depth == 0) l[sample] = py::str(t);
-      else py::list(l[sample]).append(py::str(t));
+      if (c.depth == 0)
+        l[sample] = py::str(t);
+      else
+        py::list(l[sample]).append(py::str(t));
     });
   }
   template <class T, std::size_t N>
   void array(const char* name, const std::array<T, N>& a) {
     put(name, Kind::kFloat, static_cast<int>(N), [&](Column& c, std::size_t o) {
-      for (std::size_t k = 0; k < N; ++k) static_cast<double*>(c.data)[o + k] = static_cast<double>(a[k]);
+      for (std::size_t k = 0; k < N; ++k)
+        static_cast<double*>(c.data)[o + k] = static_cast<double>(a[k]);
     });
   }
   void vector(const char* name, const msg::Vec3& v) {
@@ -100,8 +110,10 @@ class Columns {
     if constexpr (!std::is_arithmetic_v<T>) prefix_ = prefix(name);
     for (std::size_t k = 0; k < seq.size(); ++k) {
       at_[depth_++] = k;
-      if constexpr (std::is_arithmetic_v<T>) value(name, seq[k]);
-      else wire::visit(seq[k], *this);
+      if constexpr (std::is_arithmetic_v<T>)
+        value(name, seq[k]);
+      else
+        wire::visit(seq[k], *this);
       --depth_;
     }
     at_[depth_] = 0;
@@ -125,10 +137,18 @@ class Columns {
           c.array = l;
           break;
         }
-        case Kind::kFloat: c.array = alloc<double>(c, shape, n, std::numeric_limits<double>::quiet_NaN()); break;
-        case Kind::kU64: c.array = alloc<std::uint64_t>(c, shape, n, 0); break;
-        case Kind::kI64: c.array = alloc<std::int64_t>(c, shape, n, 0); break;
-        case Kind::kBool: c.array = alloc<bool>(c, shape, n, false); break;
+        case Kind::kFloat:
+          c.array = alloc<double>(c, shape, n, std::numeric_limits<double>::quiet_NaN());
+          break;
+        case Kind::kU64:
+          c.array = alloc<std::uint64_t>(c, shape, n, 0);
+          break;
+        case Kind::kI64:
+          c.array = alloc<std::int64_t>(c, shape, n, 0);
+          break;
+        case Kind::kBool:
+          c.array = alloc<bool>(c, shape, n, false);
+          break;
       }
     }
     fill = true;
@@ -143,7 +163,8 @@ class Columns {
  private:
   struct KeyHash {
     std::size_t operator()(const std::pair<int, const char*>& k) const {
-      return std::hash<const void*>()(k.second) ^ (static_cast<std::size_t>(k.first) * 0x9e3779b97f4a7c15ULL);
+      return std::hash<const void*>()(k.second) ^
+             (static_cast<std::size_t>(k.first) * 0x9e3779b97f4a7c15ULL);
     }
   };
   using Key = std::pair<int, const char*>;

@@ -13,16 +13,19 @@ namespace ddswarm::gs {
 void add_record_command_line(CLI::App& app, RecordCommandLine& cl) {
   app.add_option("-o,--output", cl.opt.path, "output .mcap file");
   app.add_option("--topics", cl.opt.topics, "topics to record (default: all)")->delimiter(',');
-  app.add_option("--duration", cl.duration_s, "stop after this many wall seconds (0 = until Ctrl-C)")
+  app.add_option("--duration", cl.duration_s,
+                 "stop after this many wall seconds (0 = until Ctrl-C)")
       ->check(finite_range(0.0, 1e9));
   app.add_option("--compression", cl.opt.compression, "chunk compression")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}));
-  app.add_option("--chunk-kb", cl.chunk_kb, "uncompressed KiB per chunk (a crash loses at most one)")
+  app.add_option("--chunk-kb", cl.chunk_kb,
+                 "uncompressed KiB per chunk (a crash loses at most one)")
       ->check(CLI::Range(1, 1 << 20));
   add_dds_options(app, cl.dds);
   cl.info = app.add_subcommand("info", "describe a recording");
   cl.info->add_option("file", cl.info_path, "recording")->required();
-  cl.info->add_flag("--messages", cl.list_messages, "also list every message: log time, topic, bytes, payload hash");
+  cl.info->add_flag("--messages", cl.list_messages,
+                    "also list every message: log time, topic, bytes, payload hash");
 }
 
 int run_record(RecordCommandLine& cl) {
@@ -53,8 +56,8 @@ std::string record_summary(const RecorderCounts& counts, const std::string& path
     if (n || missed) out += fmt::format("  {:<24} {}{}\n", topic, n, note);
     total += n;
   }
-  out += fmt::format("ddswarm-record: {} messages, {:.2f} MB written to {} (peak queue {})\n", total,
-                     counts.bytes / 1e6, path, counts.max_queue);
+  out += fmt::format("ddswarm-record: {} messages, {:.2f} MB written to {} (peak queue {})\n",
+                     total, counts.bytes / 1e6, path, counts.max_queue);
   if (counts.rejoins)
     out += fmt::format(
         "ddswarm-record: joined DDS again {} time(s) after a stop longer than the lease; "
@@ -77,7 +80,8 @@ void add_replay_command_line(CLI::App& app, ReplayCommandLine& cl) {
 int run_replay(const ReplayCommandLine& cl) {
   install_stop_signals();
   auto n = Replay(cl.dds, cl.path, cl.rate, cl.loop, cl.topics).run();
-  std::fprintf(stderr, "ddswarm-replay: %llu messages published\n", static_cast<unsigned long long>(n));
+  std::fprintf(stderr, "ddswarm-replay: %llu messages published\n",
+               static_cast<unsigned long long>(n));
   return 0;
 }
 

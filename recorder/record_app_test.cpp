@@ -21,16 +21,18 @@ std::string printf_summary(const RecorderCounts& counts, const std::string& path
   std::uint64_t total = 0;
   for (const auto& [topic, n] : counts.messages) {
     const auto missed = counts.missed.count(topic) ? counts.missed.at(topic) : 0;
-    const std::string note = missed ? " (" + std::to_string(missed) + " more were sent but never received)" : "";
+    const std::string note =
+        missed ? " (" + std::to_string(missed) + " more were sent but never received)" : "";
     if (n || missed) {
-      std::snprintf(line, sizeof line, "  %-24s %llu%s\n", topic.c_str(), static_cast<unsigned long long>(n),
-                    note.c_str());
+      std::snprintf(line, sizeof line, "  %-24s %llu%s\n", topic.c_str(),
+                    static_cast<unsigned long long>(n), note.c_str());
       out += line;
     }
     total += n;
   }
-  std::snprintf(line, sizeof line, "ddswarm-record: %llu messages, %.2f MB written to %s (peak queue %zu)\n",
-                static_cast<unsigned long long>(total), counts.bytes / 1e6, path.c_str(), counts.max_queue);
+  std::snprintf(
+      line, sizeof line, "ddswarm-record: %llu messages, %.2f MB written to %s (peak queue %zu)\n",
+      static_cast<unsigned long long>(total), counts.bytes / 1e6, path.c_str(), counts.max_queue);
   out += line;
   if (counts.rejoins) {
     std::snprintf(line, sizeof line,

@@ -76,7 +76,7 @@ struct Recorder::Impl {
   std::size_t max_queue = 0;
   std::map<std::uint16_t, std::string> channel_topic;
   std::map<std::string, std::uint64_t> written;
-  std::size_t not_written = 0;  // of a batch whose write failed
+  std::size_t not_written = 0;                  // of a batch whose write failed
   std::map<std::string, SequenceGaps> gaps_of;  // per topic, under mu: samples sent that never came
 
   static mcap::WriterOptions writer_options(const RecorderOptions& o) {
@@ -98,11 +98,12 @@ struct Recorder::Impl {
     const auto known = all_topics();
     for (const auto& t : opt.topics)
       if (!known.count(t))
-        throw std::invalid_argument("unknown topic " + t + " (known: " +
-                                    fmt::format("{}", fmt::join(known, ", ")) + ")");
+        throw std::invalid_argument("unknown topic " + t +
+                                    " (known: " + fmt::format("{}", fmt::join(known, ", ")) + ")");
     for_each_topic_type([&]<class T>() {
       const std::string topic = Topic<T>::name;
-      if (!opt.topics.empty() && std::find(opt.topics.begin(), opt.topics.end(), topic) == opt.topics.end())
+      if (!opt.topics.empty() &&
+          std::find(opt.topics.begin(), opt.topics.end(), topic) == opt.topics.end())
         return;
       typename Topic<T>::PubSub type;
       const std::uint16_t schema = writer.add_schema(type.getName(), "omgidl", kIdlText);
@@ -199,7 +200,8 @@ struct Recorder::Impl {
         }
         {
           std::unique_lock<std::mutex> lock(mu);
-          cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return !queue.empty() || stopping; });
+          cv.wait_for(lock, std::chrono::milliseconds(100),
+                      [&] { return !queue.empty() || stopping; });
         }
         drain();
       }
@@ -220,10 +222,11 @@ struct Recorder::Impl {
         writer.close();
       } catch (const std::exception&) {
       }
-      throw std::runtime_error(fmt::format(
-          "{}; recording stopped: {} messages were handed to the file, {} more received were not written; "
-          "{} reads up to its last complete chunk (ddswarm-record info)",
-          e.what(), total_written(), unwritten, opt.path));
+      throw std::runtime_error(
+          fmt::format("{}; recording stopped: {} messages were handed to the file, {} more "
+                      "received were not written; "
+                      "{} reads up to its last complete chunk (ddswarm-record info)",
+                      e.what(), total_written(), unwritten, opt.path));
     }
     RecorderCounts c;
     c.messages = written;
@@ -265,7 +268,8 @@ std::string describe_recording(const std::string& path, bool messages) {
       std::uint64_t h = 1469598103934665603ULL;
       for (auto b : m.data) h = (h ^ b) * 1099511628211ULL;
       const auto* ch = r.channel(m.channel_id);
-      out += fmt::format("{} {} {} {:016x}\n", m.log_time_ns, ch ? ch->topic : "?", m.data.size(), h);
+      out +=
+          fmt::format("{} {} {} {:016x}\n", m.log_time_ns, ch ? ch->topic : "?", m.data.size(), h);
     });
   }
   return out;
@@ -281,8 +285,13 @@ std::uint64_t replay(const DdsConfig& dds, const std::string& path, double rate,
   return Replay(dds, path, rate, loop, topics).run();
 }
 
-Replay::Replay(DdsConfig dds, std::string path, double rate, bool loop, std::vector<std::string> topics)
-    : dds_(std::move(dds)), path_(std::move(path)), rate_(rate), loop_(loop), topics_(std::move(topics)) {}
+Replay::Replay(DdsConfig dds, std::string path, double rate, bool loop,
+               std::vector<std::string> topics)
+    : dds_(std::move(dds)),
+      path_(std::move(path)),
+      rate_(rate),
+      loop_(loop),
+      topics_(std::move(topics)) {}
 
 bool Replay::stopping() const { return stop_ || stop_requested(); }
 
@@ -310,20 +319,23 @@ std::uint64_t Replay::run() {
   // transient-local ones: the swarm state, scene, status, missions, acks).
   std::set<std::uint16_t> shared;
   for (const auto& [id, ch] : r.channels()) {
-    if (!topics.empty() && std::find(topics.begin(), topics.end(), ch.topic) == topics.end()) continue;
-    for_each_topic_type([&, id = id, &ch = ch]<class T>() {  // clang 14 cannot capture a structured binding
-      if (ch.topic != Topic<T>::name) return;
-      auto w = std::make_shared<Writer<T>>(dds.writer<T>());
-      if (!dds.profile_never_shares<T>()) shared.insert(id);
-      publish[id] = [w](std::span<const std::uint8_t> bytes) {
-        typename Topic<T>::PubSub type;
-        eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
-        std::memcpy(payload.data, bytes.data(), bytes.size());
-        payload.length = static_cast<std::uint32_t>(bytes.size());
-        T sample;
-        if (type.deserialize(&payload, &sample)) w->write(sample);
-      };
-    });
+    if (!topics.empty() && std::find(topics.begin(), topics.end(), ch.topic) == topics.end())
+      continue;
+    for_each_topic_type(
+        [&, id = id, &ch = ch]<class T>() {  // clang 14 cannot capture a structured binding
+          if (ch.topic != Topic<T>::name) return;
+          auto w = std::make_shared<Writer<T>>(dds.writer<T>());
+          if (!dds.profile_never_shares<T>()) shared.insert(id);
+          publish[id] = [w](std::span<const std::uint8_t> bytes) {
+            typename Topic<T>::PubSub type;
+            eprosima::fastrtps::rtps::SerializedPayload_t payload(
+                static_cast<std::uint32_t>(bytes.size()));
+            std::memcpy(payload.data, bytes.data(), bytes.size());
+            payload.length = static_cast<std::uint32_t>(bytes.size());
+            T sample;
+            if (type.deserialize(&payload, &sample)) w->write(sample);
+          };
+        });
   }
   // Let readers match before the first sample (volatile samples sent earlier
   // are lost), and a live server's scene (transient local) arrive.
@@ -364,8 +376,9 @@ std::uint64_t Replay::run() {
         have_first = true;
       }
       const double offset_s = (m.log_time_ns - first) * 1e-9 / rate;
-      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                std::chrono::duration<double>(offset_s)));
+      std::this_thread::sleep_until(start +
+                                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                        std::chrono::duration<double>(offset_s)));
       it->second(m.data);
       ++sent;
     });

@@ -17,7 +17,8 @@ struct RecorderOptions {
   std::string path;                  ///< output .mcap
   std::vector<std::string> topics;   ///< topic names to record; empty = every ddswarm topic
   std::string compression = "zstd";  ///< zstd | lz4 | none
-  std::uint64_t chunk_bytes = 1 << 20;  ///< uncompressed bytes per chunk (what a crash can lose at most)
+  std::uint64_t chunk_bytes =
+      1 << 20;  ///< uncompressed bytes per chunk (what a crash can lose at most)
 };
 
 struct RecorderCounts {

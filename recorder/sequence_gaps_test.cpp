@@ -13,8 +13,9 @@ SequenceGaps::WriterId writer(std::uint8_t k) {
 
 TEST(SequenceGaps, CountsWhatEachWriterSkipped) {
   SequenceGaps g;
-  for (std::uint64_t s : {7, 8, 11, 12}) g.received(writer(1), s);  // joined at 7: owed nothing before; 9, 10 lost
-  for (std::uint64_t s : {1, 2, 6}) g.received(writer(2), s);        // its own numbers: 3, 4, 5 lost
+  for (std::uint64_t s : {7, 8, 11, 12})
+    g.received(writer(1), s);  // joined at 7: owed nothing before; 9, 10 lost
+  for (std::uint64_t s : {1, 2, 6}) g.received(writer(2), s);  // its own numbers: 3, 4, 5 lost
   EXPECT_EQ(g.missed(), 5u);
   EXPECT_EQ(g.writers(), 2u);
 }

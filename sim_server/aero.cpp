@@ -18,7 +18,8 @@ double ground_effect_ratio(double z_m, double r_m) {
   return 1.0 / (1.0 - k * k);
 }
 
-double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above, const Eigen::Vector3d& below, double r_m) {
+double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above,
+                      const Eigen::Vector3d& below, double r_m) {
   const double dz = above.z() - below.z();
   const double dxy = (above - below).head<2>().norm();
   if (!(dz > 0) || dxy >= 10.0) return 0.0;

@@ -37,8 +37,10 @@ struct AeroConfig {
 
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    v.field("ground_effect", c.ground_effect, {"", any(), "Cheeseman-Bennett thrust ratio below two rotor diameters"});
-    v.field("downwash", c.downwash, {"", any(), "a drone's downwash on those beneath it (gym-pybullet-drones' model)"});
+    v.field("ground_effect", c.ground_effect,
+            {"", any(), "Cheeseman-Bennett thrust ratio below two rotor diameters"});
+    v.field("downwash", c.downwash,
+            {"", any(), "a drone's downwash on those beneath it (gym-pybullet-drones' model)"});
     v.field("downwash_c1_n", c.downwash_c1_n, {"N", non_negative(), "the model's C1"});
     v.field("downwash_c2", c.downwash_c2, {"", any(), "the model's C2"});
     v.field("downwash_c3_m", c.downwash_c3_m, {"m", any(), "the model's C3"});
@@ -51,7 +53,8 @@ double ground_effect_ratio(double z_m, double r_m);
 
 /// The downward force (N, >= 0) on a drone at `below` from one at `above`
 /// whose rotors have radius r_m.
-double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above, const Eigen::Vector3d& below, double r_m);
+double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above,
+                      const Eigen::Vector3d& below, double r_m);
 
 /// Reads section `aero`; unknown keys throw ConfigError with file and line.
 void load(YamlSection s, AeroConfig& c);

@@ -43,8 +43,8 @@ Verdict AgentRegistry::check(const CommandFacts& c, double max_speed_mps) const 
   return check_command(c, g);
 }
 
-AgentRegistry::Recorded AgentRegistry::record(int id, std::uint64_t instance, const CommandRecord& c,
-                                              double now_wall_s) {
+AgentRegistry::Recorded AgentRegistry::record(int id, std::uint64_t instance,
+                                              const CommandRecord& c, double now_wall_s) {
   Recorded r;
   AgentSlot& s = slots_[id];
   r.online = adopt(s, id, instance, now_wall_s);
@@ -52,7 +52,8 @@ AgentRegistry::Recorded AgentRegistry::record(int id, std::uint64_t instance, co
   s.setpoint = c.setpoint;
   s.has_command = true;
   s.command_tick = c.tick;
-  if (c.mission_seq != s.mission_seq || c.mission_issuer != s.mission_issuer || c.phase != s.phase) {
+  if (c.mission_seq != s.mission_seq || c.mission_issuer != s.mission_issuer ||
+      c.phase != s.phase) {
     s.mission_seq = c.mission_seq;
     s.mission_issuer = c.mission_issuer;
     r.status_due = true;
@@ -80,7 +81,9 @@ AgentRegistry::Expiry AgentRegistry::expire(double now, double agent_timeout_s) 
   e.newest_silence_s = now - newest;
   e.silence_began = silence_.silent() && !was_silent;
   // A live agent's silence as this check counts it (SwarmSilence).
-  auto silence = [&](const AgentSlot& s) { return now - silence_.silent_since(s.last_heard_wall_s); };
+  auto silence = [&](const AgentSlot& s) {
+    return now - silence_.silent_since(s.last_heard_wall_s);
+  };
   double longest = 0;
   for (const auto& s : slots_)
     if (s.live && silence(s) > timeout) {

@@ -25,7 +25,8 @@ struct AgentSlot {
   std::uint64_t owner = 0;  ///< agent instance flying this drone, 0 = none
   bool live = false;
   double last_heard_wall_s = -1e9;
-  std::uint32_t mission_seq = 0;     ///< last mission command its agent accepted (relayed in SimStatus)
+  std::uint32_t mission_seq =
+      0;  ///< last mission command its agent accepted (relayed in SimStatus)
   std::uint64_t mission_issuer = 0;  ///< and its issuer
 };
 
@@ -78,7 +79,7 @@ class AgentRegistry {
 
   /// What expire found, in the order the server reports it.
   struct Expiry {
-    bool silence_began = false;  ///< no live agent heard for a while: limit_s lengthened
+    bool silence_began = false;   ///< no live agent heard for a while: limit_s lengthened
     double newest_silence_s = 0;  ///< s since any live agent was heard
     double limit_s = 0;           ///< the silence limit that applied
     bool holding_began = false;   ///< several past the limit at once: held (declare_lost_now)

@@ -6,14 +6,22 @@ namespace ddswarm::sim {
 
 const char* to_string(Verdict v) {
   switch (v) {
-    case Verdict::kAccept: return "accepted";
-    case Verdict::kNonFinite: return "non-finite value";
-    case Verdict::kAbsurd: return "absurd value";
-    case Verdict::kUnknownId: return "unknown drone id";
-    case Verdict::kImpostor: return "drone already flown by another agent";
-    case Verdict::kStaleTick: return "stale tick";
-    case Verdict::kFutureTick: return "future tick";
-    case Verdict::kRepeat: return "repeated answer";
+    case Verdict::kAccept:
+      return "accepted";
+    case Verdict::kNonFinite:
+      return "non-finite value";
+    case Verdict::kAbsurd:
+      return "absurd value";
+    case Verdict::kUnknownId:
+      return "unknown drone id";
+    case Verdict::kImpostor:
+      return "drone already flown by another agent";
+    case Verdict::kStaleTick:
+      return "stale tick";
+    case Verdict::kFutureTick:
+      return "future tick";
+    case Verdict::kRepeat:
+      return "repeated answer";
   }
   return "?";
 }

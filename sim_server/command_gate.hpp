@@ -10,13 +10,13 @@ namespace ddswarm::sim {
 
 enum class Verdict {
   kAccept,
-  kNonFinite,    ///< NaN or inf anywhere
-  kAbsurd,       ///< speed or yaw rate beyond any sane limit
-  kUnknownId,    ///< drone id not in this scenario
-  kImpostor,     ///< another agent instance already flies this drone
-  kStaleTick,    ///< older than what is being collected
-  kFutureTick,   ///< for a tick not yet published
-  kRepeat,       ///< lockstep: the owner answers a tick published twice again; dropped
+  kNonFinite,   ///< NaN or inf anywhere
+  kAbsurd,      ///< speed or yaw rate beyond any sane limit
+  kUnknownId,   ///< drone id not in this scenario
+  kImpostor,    ///< another agent instance already flies this drone
+  kStaleTick,   ///< older than what is being collected
+  kFutureTick,  ///< for a tick not yet published
+  kRepeat,      ///< lockstep: the owner answers a tick published twice again; dropped
 };
 
 const char* to_string(Verdict v);
@@ -32,7 +32,8 @@ struct CommandFacts {
 struct GateContext {
   int num_drones;
   std::uint64_t published_tick;  ///< newest tick published
-  std::uint64_t oldest_ok_tick;  ///< lockstep: published_tick; realtime: last applied tick of this drone
+  std::uint64_t
+      oldest_ok_tick;  ///< lockstep: published_tick; realtime: last applied tick of this drone
   std::uint64_t owner_instance;  ///< the live agent instance of this drone, 0 = none
   double max_speed_mps;
   /// Lockstep: the tick the owner's applied answer was for (none: no answer yet).

@@ -7,20 +7,22 @@ namespace ddswarm::sim {
 FailsafePolicy::FailsafePolicy(int drones, FailsafeRules rules)
     : rules_(rules), since_s_(static_cast<std::size_t>(drones), -1.0) {}
 
-SetpointChoice FailsafePolicy::choose(int i, const CommandView& c, std::uint64_t tick, bool airborne,
-                                      const VelocitySetpoint& applied) {
+SetpointChoice FailsafePolicy::choose(int i, const CommandView& c, std::uint64_t tick,
+                                      bool airborne, const VelocitySetpoint& applied) {
   SetpointChoice out;
   const double t = static_cast<double>(tick) * rules_.period_s;
   double& since = since_s_[i];
-  const bool fresh = c.has_command && c.live &&
-                     (static_cast<double>(tick - std::min(tick, c.command_tick)) * rules_.period_s <=
-                      rules_.command_timeout_s);
+  const bool fresh =
+      c.has_command && c.live &&
+      (static_cast<double>(tick - std::min(tick, c.command_tick)) * rules_.period_s <=
+       rules_.command_timeout_s);
   if (fresh) {
     if (since >= 0) out.change = SetpointChoice::Change::kResumed;
     since = -1;
     out.setpoint = c.setpoint;
     out.fresh = true;
-    out.command_age_s = static_cast<float>((tick - std::min(tick, c.command_tick)) * rules_.period_s);
+    out.command_age_s =
+        static_cast<float>((tick - std::min(tick, c.command_tick)) * rules_.period_s);
     return out;
   }
   if (since < 0) {

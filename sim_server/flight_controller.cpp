@@ -20,7 +20,8 @@ Eigen::Quaterniond canonical(const Eigen::Quaterniond& q) {
 
 /// Attitude with body z along z_world_des and heading yaw (PX4 bodyzToAttitude).
 /// cos_yaw, sin_yaw: of the heading yaw.
-Eigen::Quaterniond attitude_from_thrust(const Eigen::Vector3d& z_des, double cos_yaw, double sin_yaw) {
+Eigen::Quaterniond attitude_from_thrust(const Eigen::Vector3d& z_des, double cos_yaw,
+                                        double sin_yaw) {
   const Eigen::Vector3d x_course(cos_yaw, sin_yaw, 0.0);
   Eigen::Vector3d y_des = z_des.cross(x_course);
   if (y_des.squaredNorm() < 1e-12) y_des = Eigen::Vector3d(-sin_yaw, cos_yaw, 0.0);

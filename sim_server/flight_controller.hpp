@@ -97,7 +97,7 @@ class FlightController {
   ControllerConfig cfg_;
   Mixer mixer_;
   Eigen::Vector3d inertia_;
-  double tan_max_tilt_;  ///< tan(cfg_.max_tilt_rad)
+  double tan_max_tilt_;                                         ///< tan(cfg_.max_tilt_rad)
   double trig_yaw_ = std::numeric_limits<double>::quiet_NaN();  ///< the yaw_sp_ of the two below
   double cos_yaw_sp_ = 1.0, sin_yaw_sp_ = 0.0;
   double yaw_sp_ = 0.0;

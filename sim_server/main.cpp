@@ -22,11 +22,13 @@ int main(int argc, char** argv) {
     std::optional<std::string> mode;
     ddswarm::DdsConfig dds_cli;
     app.add_option("--scenario,scenario", scenario, "scenario YAML")->required();
-    app.add_option("--duration", duration_s, "stop after this many wall seconds (0 = run until Ctrl-C)")
+    app.add_option("--duration", duration_s,
+                   "stop after this many wall seconds (0 = run until Ctrl-C)")
         ->check(ddswarm::finite_range(0.0, 1e9));
     app.add_option("--seed", seed, "override scenario.seed");
     app.add_option("--drones", drones, "override scenario.drones");
-    app.add_option("--mode", mode, "override scenario.mode")->check(CLI::IsMember({"realtime", "lockstep"}));
+    app.add_option("--mode", mode, "override scenario.mode")
+        ->check(CLI::IsMember({"realtime", "lockstep"}));
     bool check = false;
     app.add_flag(
         "--check", check,
@@ -41,7 +43,9 @@ int main(int argc, char** argv) {
     auto cfg = ddswarm::sim::load_server_config(scenario);
     if (seed) cfg.scenario.seed = *seed;
     if (drones) cfg.scenario.drones = *drones;
-    if (mode) cfg.scenario.mode = *mode == "lockstep" ? ddswarm::TimeMode::kLockstep : ddswarm::TimeMode::kRealtime;
+    if (mode)
+      cfg.scenario.mode =
+          *mode == "lockstep" ? ddswarm::TimeMode::kLockstep : ddswarm::TimeMode::kRealtime;
     ddswarm::merge_cli(cfg.dds, dds_cli, app);
     ddswarm::default_security_role(cfg.dds, "server");
     ddswarm::validate_with_overrides(scenario, [&] { cfg.validate(); });

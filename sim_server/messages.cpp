@@ -18,9 +18,10 @@ void CollisionCounts::add(const ContactEvent& e) {
   }
 }
 
-msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim, const SceneConfig& scene,
-                         const QuadrotorParams& quadrotor, const SensorConfig& sensors,
-                         const std::vector<Eigen::Vector3d>& starts, std::uint64_t server_instance) {
+msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim,
+                         const SceneConfig& scene, const QuadrotorParams& quadrotor,
+                         const SensorConfig& sensors, const std::vector<Eigen::Vector3d>& starts,
+                         std::uint64_t server_instance) {
   msg::Scene s = to_msg(scene);
   s.name(scenario.name.substr(0, 127));
   s.seed(scenario.seed);
@@ -88,12 +89,13 @@ void refresh_agent_live(std::vector<msg::DroneState>& drones, const AgentRegistr
   for (std::size_t i = 0; i < std::min<std::size_t>(agents.size(), drones.size()); ++i) {
     auto& d = drones[i];
     const std::uint16_t others = d.flags() & ~static_cast<std::uint16_t>(msg::DRONE_AGENT_LIVE);
-    d.flags(static_cast<std::uint16_t>(others | (agents[static_cast<int>(i)].live ? msg::DRONE_AGENT_LIVE : 0)));
+    d.flags(static_cast<std::uint16_t>(
+        others | (agents[static_cast<int>(i)].live ? msg::DRONE_AGENT_LIVE : 0)));
   }
 }
 
-void fill_scan(msg::DistanceScan& sc, std::uint64_t tick, double sim_time_s, const std::vector<float>& range_m,
-               const std::vector<std::uint8_t>& hit) {
+void fill_scan(msg::DistanceScan& sc, std::uint64_t tick, double sim_time_s,
+               const std::vector<float>& range_m, const std::vector<std::uint8_t>& hit) {
   sc.tick(tick);
   sc.sim_time_s(sim_time_s);
   sc.range_m().assign(range_m.begin(), range_m.end());
@@ -171,7 +173,8 @@ int collision_kind(ContactKind k) {
   return k == ContactKind::kObstacle ? 0 : k == ContactKind::kDrone ? 1 : 2;
 }
 
-msg::CollisionEvent collision_message(std::uint64_t tick, double sim_time_s, const ContactEvent& e) {
+msg::CollisionEvent collision_message(std::uint64_t tick, double sim_time_s,
+                                      const ContactEvent& e) {
   msg::CollisionEvent m;
   m.tick(tick);
   m.sim_time_s(sim_time_s);

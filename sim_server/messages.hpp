@@ -12,8 +12,8 @@
 #include "DistanceScan.h"
 #include "DroneState.h"
 #include "Scene.h"
-#include "SwarmState.h"
 #include "SimStatus.h"
+#include "SwarmState.h"
 #include "TaskStatus.h"
 #include "common/mission.hpp"
 #include "common/scenario.hpp"
@@ -38,9 +38,10 @@ struct CollisionCounts {
 };
 
 /// The world and the swarm as this server runs them; published once, as it joins.
-msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim, const SceneConfig& scene,
-                         const QuadrotorParams& quadrotor, const SensorConfig& sensors,
-                         const std::vector<Eigen::Vector3d>& starts, std::uint64_t server_instance);
+msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim,
+                         const SceneConfig& scene, const QuadrotorParams& quadrotor,
+                         const SensorConfig& sensors, const std::vector<Eigen::Vector3d>& starts,
+                         std::uint64_t server_instance);
 
 /// A SwarmState for n drones with what never changes filled in: each scan's
 /// drone id, max range and ray angles (rad, body frame, +CCW).
@@ -69,8 +70,8 @@ void fill_drone_state(msg::DroneState& d, const DroneFacts& f, const CollisionCo
 void refresh_agent_live(std::vector<msg::DroneState>& drones, const AgentRegistry& agents);
 
 /// Fills a scan with the ranges (m) and hits a cast measured at tick.
-void fill_scan(msg::DistanceScan& sc, std::uint64_t tick, double sim_time_s, const std::vector<float>& range_m,
-               const std::vector<std::uint8_t>& hit);
+void fill_scan(msg::DistanceScan& sc, std::uint64_t tick, double sim_time_s,
+               const std::vector<float>& range_m, const std::vector<std::uint8_t>& hit);
 
 /// Adds each drone's agent (live, mission seq and issuer, phase) to s.
 void add_agents(msg::SimStatus& s, const AgentRegistry& agents);

@@ -8,14 +8,19 @@ namespace {
 int command_class(std::uint8_t type) {
   switch (static_cast<MissionType>(type)) {
     case MissionType::kTakeoff:
-    case MissionType::kLand: return 0;
-    case MissionType::kSetDistance: return 1;
+    case MissionType::kLand:
+      return 0;
+    case MissionType::kSetDistance:
+      return 1;
     case MissionType::kMove:
     case MissionType::kTask:
     case MissionType::kFollowLeader:
-    case MissionType::kHold: return 2;
-    case MissionType::kTeleop: return 3;
-    case MissionType::kNone: break;
+    case MissionType::kHold:
+      return 2;
+    case MissionType::kTeleop:
+      return 3;
+    case MissionType::kNone:
+      break;
   }
   return 4;  // unknown: never defines the mission
 }

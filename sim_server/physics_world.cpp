@@ -169,7 +169,8 @@ struct GatherProxies : btBroadphaseAabbCallback {
 class DroneDispatcher final : public btCollisionDispatcher {
  public:
   DroneDispatcher(btCollisionConfiguration* config, double ground_z_m)
-      : btCollisionDispatcher(config), clear_above_z_(static_cast<btScalar>(ground_z_m) + kGroundClearM) {
+      : btCollisionDispatcher(config),
+        clear_above_z_(static_cast<btScalar>(ground_z_m) + kGroundClearM) {
     setNearCallback(&DroneDispatcher::near_callback);
   }
 
@@ -224,7 +225,8 @@ class DroneDynamicsWorld final : public btDiscreteDynamicsWorld {
     for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) {
       btRigidBody* body = m_nonStaticRigidBodies[i];
       if (body->isStaticOrKinematicObject()) continue;
-      if (body->getLinearDamping() != 0 || body->getAngularDamping() != 0) body->applyDamping(time_step);
+      if (body->getLinearDamping() != 0 || body->getAngularDamping() != 0)
+        body->applyDamping(time_step);
       body->predictIntegratedTransform(time_step, body->getInterpolationWorldTransform());
     }
   }
@@ -236,7 +238,8 @@ class DroneDynamicsWorld final : public btDiscreteDynamicsWorld {
         return;
       }
     releasePredictiveContacts();
-    for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i) m_nonStaticRigidBodies[i]->setHitFraction(1.f);
+    for (int i = 0; i < m_nonStaticRigidBodies.size(); ++i)
+      m_nonStaticRigidBodies[i]->setHitFraction(1.f);
   }
 };
 
@@ -386,7 +389,8 @@ void PhysicsWorld::step(double dt) {
       const double w2 = d.omega[i] * d.omega[i];
       double t = k_f_ * w2;
       // Each rotor's hub height above the ground sets its ground effect.
-      if (aero_.ground_effect) t *= ground_effect_ratio((p + r * rotor_pos_[i]).z() - ground_z_m_, prop_r);
+      if (aero_.ground_effect)
+        t *= ground_effect_ratio((p + r * rotor_pos_[i]).z() - ground_z_m_, prop_r);
       thrust += t;
       torque_b.x() += rotor_pos_[i].y() * t;
       torque_b.y() -= rotor_pos_[i].x() * t;
@@ -402,7 +406,8 @@ void PhysicsWorld::step(double dt) {
     if (aero_.downwash)
       for (std::size_t m = 0; m < drones_.size(); ++m)
         if (m != n)
-          force_w.z() -= downwash_force(aero_, to_eigen(drones_[m].body->getWorldTransform().getOrigin()), p, prop_r);
+          force_w.z() -= downwash_force(
+              aero_, to_eigen(drones_[m].body->getWorldTransform().getOrigin()), p, prop_r);
     body.applyCentralForce(to_bt(force_w));
     body.applyTorque(to_bt(r * torque_b));
   }

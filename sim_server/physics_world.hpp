@@ -82,7 +82,9 @@ class PhysicsWorld {
   /// The air's velocity at the drone (m/s, world ENU: the wind, sim/wind.hpp);
   /// body drag acts on the velocity relative to it. Held until changed; calm
   /// (zero) at start.
-  void set_air_velocity(int drone, const Eigen::Vector3d& air_world) { drones_[drone].air_world = air_world; }
+  void set_air_velocity(int drone, const Eigen::Vector3d& air_world) {
+    drones_[drone].air_world = air_world;
+  }
   /// Ground effect and downwash (sim/aero.hpp); off unless set.
   void set_aero(const AeroConfig& aero) { aero_ = aero; }
 

@@ -166,7 +166,8 @@ TEST(PhysicsWorld, GroundEffectLiftsAHoverNearTheGroundAsCheesemanAndBennettSay)
   const double h = q.hover_omega();
   w.set_rotor_commands(0, {h, h, h, h});
   step_for(w, 0.1);
-  w.reset_drone(0, {0, 0, r - q.collision_half_height_m}, 0.0);  // the body centre (the rotor plane) at z = R
+  w.reset_drone(0, {0, 0, r - q.collision_half_height_m},
+                0.0);  // the body centre (the rotor plane) at z = R
   w.set_rotor_commands(0, {h, h, h, h});
   step_for(w, 0.05);  // the motors spin up again (5 ms lag)
   const double v0 = w.state(0).v_world.z();
@@ -187,7 +188,8 @@ TEST(PhysicsWorld, DownwashPushesADroneHalfAMetreBelowAnotherAsTheModelSays) {
   step_for(w, 0.02);
   const double v_top = w.state(0).v_world.z(), v_low = w.state(1).v_world.z();
   step_for(w, 0.005);
-  const double force = downwash_force(a, w.state(0).p_world, w.state(1).p_world, 0.5 * q.prop_diameter_m);
+  const double force =
+      downwash_force(a, w.state(0).p_world, w.state(1).p_world, 0.5 * q.prop_diameter_m);
   EXPECT_GT(force, 1.0);
   // Against the drone above, which feels nothing (both still spin up alike).
   const double a_top = (w.state(0).v_world.z() - v_top) / 0.005;
@@ -564,7 +566,8 @@ TEST(Contacts, ManyDronesRestingProduceNoEvents) {
 /// together, one drone moved through the air, landing) in both worlds gives
 /// the same state, bit for bit, at every step, and the same contact events.
 TEST(BulletPath, ShortcutsGiveBulletsStockResultsBitForBit) {
-  const SceneConfig scene = scene_with({Cylinder{{3, 0}, 0.5, 5}}, {Box{{-4, 4, 1}, {1, 1, 2}, 0.3}});
+  const SceneConfig scene =
+      scene_with({Cylinder{{3, 0}, 0.5, 5}}, {Box{{-4, 4, 1}, {1, 1, 2}, 0.3}});
   const std::vector<Eigen::Vector3d> starts{{0, 0, 0}, {0, 3, 0}, {1.2, 3, 0}};
   Swarm fast(scene, starts, 0.2, BulletPath::kShortcuts);
   Swarm stock(scene, starts, 0.2, BulletPath::kStock);
@@ -579,7 +582,8 @@ TEST(BulletPath, ShortcutsGiveBulletsStockResultsBitForBit) {
         const RigidState a = fast.world.state(i), b = stock.world.state(i);
         ASSERT_EQ(a.p_world, b.p_world) << "drone " << i << " at step " << steps;
         ASSERT_EQ(a.v_world, b.v_world) << "drone " << i << " at step " << steps;
-        ASSERT_EQ(a.q_world_body.coeffs(), b.q_world_body.coeffs()) << "drone " << i << " at step " << steps;
+        ASSERT_EQ(a.q_world_body.coeffs(), b.q_world_body.coeffs())
+            << "drone " << i << " at step " << steps;
         ASSERT_EQ(a.w_body, b.w_body) << "drone " << i << " at step " << steps;
         ASSERT_EQ(fast.world.touching_ground(i), stock.world.touching_ground(i)) << "drone " << i;
       }
@@ -594,15 +598,29 @@ TEST(BulletPath, ShortcutsGiveBulletsStockResultsBitForBit) {
       events += static_cast<int>(ea.size());
     }
   };
-  both([](Swarm& s) { for (auto& p : s.sp) p.v_world = {0, 0, 1}; }, 1.5);
-  both([](Swarm& s) {
-    s.sp[0].v_world = {1, 0, 0};      // into the pillar
-    s.sp[1].v_world = {0.5, 0, 0};    // into each other
-    s.sp[2].v_world = {-0.5, 0, 0};
-  }, 4.0);
+  both(
+      [](Swarm& s) {
+        for (auto& p : s.sp) p.v_world = {0, 0, 1};
+      },
+      1.5);
+  both(
+      [](Swarm& s) {
+        s.sp[0].v_world = {1, 0, 0};    // into the pillar
+        s.sp[1].v_world = {0.5, 0, 0};  // into each other
+        s.sp[2].v_world = {-0.5, 0, 0};
+      },
+      4.0);
   both([](Swarm& s) { s.world.reset_drone(1, {-2, 3, 2.5}, 0.0); }, 1.0);  // moved, falls, caught
-  both([](Swarm& s) { for (auto& p : s.sp) p.v_world = {0, 0, -0.7}; }, 5.0);  // down to the ground
-  both([](Swarm& s) { for (auto& p : s.sp) p.motors_on = false; }, 1.0);
+  both(
+      [](Swarm& s) {
+        for (auto& p : s.sp) p.v_world = {0, 0, -0.7};
+      },
+      5.0);  // down to the ground
+  both(
+      [](Swarm& s) {
+        for (auto& p : s.sp) p.motors_on = false;
+      },
+      1.0);
   EXPECT_GE(events, 4) << "the flight must touch a pillar, a drone and the ground";
   for (int i = 0; i < fast.world.size(); ++i) EXPECT_TRUE(fast.world.touching_ground(i));
 }

@@ -12,7 +12,8 @@ RivalArbiter::Move RivalArbiter::on_scene(std::int64_t other_ns, std::int64_t no
   return std::exchange(said_, true) ? Move::kStay : Move::kStayAndSay;
 }
 
-bool RivalArbiter::leaves_for_status(bool mission_begun, const std::vector<std::uint32_t>& other_seqs) {
+bool RivalArbiter::leaves_for_status(bool mission_begun,
+                                     const std::vector<std::uint32_t>& other_seqs) {
   return !mission_begun &&
          std::any_of(other_seqs.begin(), other_seqs.end(), [](std::uint32_t q) { return q != 0; });
 }

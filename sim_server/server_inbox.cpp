@@ -44,8 +44,8 @@ void ServerInbox::subscribe(Participant& dds) {
   const Delivery commands = cfg.dds.best_effort_streams ? Delivery::kLatest : Delivery::kProfile;
   if (!dds.secure()) {
     dds.reader<msg::VelocityCommand>(
-        [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); }, std::nullopt,
-        commands);
+        [this](const msg::VelocityCommand& c, const fdds::SampleInfo&) { on_command(c); },
+        std::nullopt, commands);
   } else {
     // DDS Security: only agent-K may publish in partition drone/K, so one
     // reader per drone knows whose commands it hears; a command there for
@@ -90,8 +90,9 @@ bool ServerInbox::may_rejoin() {
     spdlog::warn("asked to join DDS again (SIGUSR1), but a mission has begun: staying");
     return false;
   }
-  spdlog::warn("asked to join DDS again (SIGUSR1, as ddswarm-launch sends when its discovery "
-               "server dropped this participant); starting again as a new server");
+  spdlog::warn(
+      "asked to join DDS again (SIGUSR1, as ddswarm-launch sends when its discovery "
+      "server dropped this participant); starting again as a new server");
   return true;
 }
 
@@ -103,13 +104,13 @@ void ServerInbox::on_rival_scene(std::uint64_t other, std::int64_t other_publish
     spdlog::error(
         "another server (instance {:016x}) is on DDS domain {}: two swarms on one domain "
         "are one swarm; it should leave (this one stays: {})",
-        other, cfg.dds.domain_id,
-        missions.begun() ? "its swarm has a mission" : "it joined first");
+        other, cfg.dds.domain_id, missions.begun() ? "its swarm has a mission" : "it joined first");
 }
 
 void ServerInbox::on_rival_status(const msg::SimStatus& s) {
   std::lock_guard<std::mutex> lock(mu);
-  if (RivalArbiter::leaves_for_status(missions.begun(), s.mission_seq())) yield_to(s.server_instance());
+  if (RivalArbiter::leaves_for_status(missions.begun(), s.mission_seq()))
+    yield_to(s.server_instance());
 }
 
 void ServerInbox::yield_to(std::uint64_t other) {
@@ -122,23 +123,43 @@ void ServerInbox::on_command(const msg::VelocityCommand& c) {
   CommandFacts f{c.drone_id(), c.tick(), from_msg(c.velocity()), c.yaw_rate_rad_s(),
                  c.agent_instance()};
   switch (agents.check(f, cfg.sim.max_command_speed_mps)) {
-    case Verdict::kAccept: break;
-    case Verdict::kNonFinite: counters.rejected_non_finite(counters.rejected_non_finite() + 1); return;
-    case Verdict::kAbsurd: counters.rejected_absurd(counters.rejected_absurd() + 1); return;
-    case Verdict::kUnknownId: counters.rejected_unknown_id(counters.rejected_unknown_id() + 1); return;
-    case Verdict::kImpostor: counters.rejected_impostor(counters.rejected_impostor() + 1); return;
-    case Verdict::kStaleTick: counters.rejected_stale_tick(counters.rejected_stale_tick() + 1); return;
-    case Verdict::kFutureTick: counters.rejected_future_tick(counters.rejected_future_tick() + 1); return;
-    case Verdict::kRepeat: return;  // an answer already applied, to a tick published twice
+    case Verdict::kAccept:
+      break;
+    case Verdict::kNonFinite:
+      counters.rejected_non_finite(counters.rejected_non_finite() + 1);
+      return;
+    case Verdict::kAbsurd:
+      counters.rejected_absurd(counters.rejected_absurd() + 1);
+      return;
+    case Verdict::kUnknownId:
+      counters.rejected_unknown_id(counters.rejected_unknown_id() + 1);
+      return;
+    case Verdict::kImpostor:
+      counters.rejected_impostor(counters.rejected_impostor() + 1);
+      return;
+    case Verdict::kStaleTick:
+      counters.rejected_stale_tick(counters.rejected_stale_tick() + 1);
+      return;
+    case Verdict::kFutureTick:
+      counters.rejected_future_tick(counters.rejected_future_tick() + 1);
+      return;
+    case Verdict::kRepeat:
+      return;  // an answer already applied, to a tick published twice
   }
-  const Phase phase = static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
-  const CommandRecord rec{{f.velocity, f.yaw_rate, c.motors_on()}, c.tick(), phase,
-                          c.mission_seq(), c.mission_issuer(), c.busy()};
+  const Phase phase =
+      static_cast<Phase>(std::min<int>(c.phase(), static_cast<int>(Phase::kFailsafe)));
+  const CommandRecord rec{{f.velocity, f.yaw_rate, c.motors_on()},
+                          c.tick(),
+                          phase,
+                          c.mission_seq(),
+                          c.mission_issuer(),
+                          c.busy()};
   const auto r = agents.record(c.drone_id(), c.agent_instance(), rec, wall_seconds());
   if (r.online) log_online(c.drone_id(), c.agent_instance());
   if (r.status_due) status_due = true;
   if (c.has_beacon() && c.own_beacon().drone_id() == c.drone_id() &&
-      std::isfinite(c.own_beacon().position().x()) && std::isfinite(c.own_beacon().position().y()) &&
+      std::isfinite(c.own_beacon().position().x()) &&
+      std::isfinite(c.own_beacon().position().y()) &&
       std::isfinite(c.own_beacon().position().z())) {
     // One beacon per drone per tick: a repeated answer replaces, never duplicates.
     std::erase_if(beacons, [&](const msg::Beacon& b) { return b.drone_id() == c.drone_id(); });
@@ -190,7 +211,8 @@ void ServerInbox::on_mission(const msg::MissionCommand& m) {
     case MissionRelay::Intake::kRepeat:
       spdlog::info("mission seq {} repeated: forwarding again for acknowledgement", m.seq());
       break;
-    case MissionRelay::Intake::kNew: break;
+    case MissionRelay::Intake::kNew:
+      break;
   }
   cv.notify_all();
 }
@@ -198,9 +220,10 @@ void ServerInbox::on_mission(const msg::MissionCommand& m) {
 void ServerInbox::expire_agents(double now_wall_s) {
   const auto e = agents.expire(now_wall_s, cfg.sim.agent_timeout_s);
   if (e.silence_began)
-    spdlog::warn("no agent heard for {:.1f} s: waiting up to {:.1f} s before declaring any lost "
-                 "(the silence may be this server's)",
-                 e.newest_silence_s, e.limit_s);
+    spdlog::warn(
+        "no agent heard for {:.1f} s: waiting up to {:.1f} s before declaring any lost "
+        "(the silence may be this server's)",
+        e.newest_silence_s, e.limit_s);
   if (e.holding_began)
     spdlog::warn(
         "{} agents silent past {:.1f} s at once: waiting up to {:.1f} s more before declaring "

@@ -37,7 +37,8 @@ struct ServerInbox {
   /// What the main loop reads once per tick, with mu held: each drone's
   /// agent live and phase; and the beacons accepted commands carried, in
   /// drone order (the radio medium), moved into `beacons_out`.
-  void take_tick(std::vector<char>& live, std::vector<Phase>& phase, std::vector<msg::Beacon>& beacons_out);
+  void take_tick(std::vector<char>& live, std::vector<Phase>& phase,
+                 std::vector<msg::Beacon>& beacons_out);
 
   /// A rejoin request came (SIGUSR1): true when the server may leave DDS and
   /// start again as a new server, which it may only before any mission

@@ -43,10 +43,11 @@ void ServerOutbox::task(const TaskReport& r, bool changed, double now) {
   last_task_publish_wall_ = now;
   w_task_.write(task_message(r, task_start_wall_ - start_wall_, now - task_start_wall_));
   if (changed && r.phase == TaskPhase::kComplete)
-    spdlog::info("task complete: {:.2f} s sim, {} obstacle / {} drone / {} ground collisions, "
-                 "min distance {:.2f} m, min clearance {:.2f} m",
-                 r.elapsed_s, r.collisions_obstacle, r.collisions_drone, r.collisions_ground,
-                 r.min_inter_drone_m, r.min_clearance_m);
+    spdlog::info(
+        "task complete: {:.2f} s sim, {} obstacle / {} drone / {} ground collisions, "
+        "min distance {:.2f} m, min clearance {:.2f} m",
+        r.elapsed_s, r.collisions_obstacle, r.collisions_drone, r.collisions_ground,
+        r.min_inter_drone_m, r.min_clearance_m);
   if (changed && r.phase == TaskPhase::kFailed) spdlog::warn("task failed: {}", r.reason);
 }
 

@@ -83,12 +83,15 @@ struct SimServer::Impl {
         pipelined(cfg.sim.lockstep_pipeline && cfg.scenario.mode == TimeMode::kLockstep),
         rt_pipelined(cfg.sim.realtime_pipeline && cfg.scenario.mode == TimeMode::kRealtime),
         starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
-        swarm(cfg.scene, cfg.quadrotor, cfg.controller, starts, cfg.scenario.seed, cfg.wind, cfg.aero),
+        swarm(cfg.scene, cfg.quadrotor, cfg.controller, starts, cfg.scenario.seed, cfg.wind,
+              cfg.aero),
         referee(cfg.scene, cfg.sim.metrics()),
         dds(cfg.dds, kServerParticipantName),
         out(dds, cfg.sim),
         in(cfg, instance,
-           pipelined ? Pipeline::kLockstep : rt_pipelined ? Pipeline::kRealtime : Pipeline::kNone),
+           pipelined      ? Pipeline::kLockstep
+           : rt_pipelined ? Pipeline::kRealtime
+                          : Pipeline::kNone),
         applied(n),
         failsafe(n, {period_s, cfg.sim.command_timeout_s, cfg.sim.failsafe_land_after_s}),
         collisions(n),
@@ -121,7 +124,8 @@ struct SimServer::Impl {
   /// real time, with the late answers to the ticks before). Call with in.mu held.
   void select_setpoints() {
     for (int i = 0; i < n; ++i) {
-      const CommandView c = pipelined || rt_pipelined ? in.agents.barrier().latched(i) : in.agents.view(i);
+      const CommandView c =
+          pipelined || rt_pipelined ? in.agents.barrier().latched(i) : in.agents.view(i);
       const bool airborne =
           swarm.state(i).p_world.z() > cfg.scene.ground_z_m + cfg.sim.airborne_height_m;
       const SetpointChoice ch = failsafe.choose(i, c, tick, airborne, applied[i]);
@@ -152,12 +156,15 @@ struct SimServer::Impl {
     referee.count_collision(kind);
     out.collision(collision_message(tick, sim_time(), e));
     spdlog::info("t={:.2f}s collision: drone {} with {} {}", sim_time(), e.drone,
-                 kind == 0 ? "obstacle" : kind == 1 ? "drone" : "ground", e.other);
+                 kind == 0   ? "obstacle"
+                 : kind == 1 ? "drone"
+                             : "ground",
+                 e.other);
   }
 
   void publish_scene() {
-    const msg::Scene s =
-        scene_message(cfg.scenario, cfg.sim, cfg.scene, cfg.quadrotor, cfg.sensors, starts, instance);
+    const msg::Scene s = scene_message(cfg.scenario, cfg.sim, cfg.scene, cfg.quadrotor, cfg.sensors,
+                                       starts, instance);
     {
       std::lock_guard<std::mutex> lock(in.mu);
       in.arbiter.published(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -184,10 +191,16 @@ struct SimServer::Impl {
     swarm_msg.tick(tick);
     swarm_msg.sim_time_s(t);
     for (int i = 0; i < n; ++i) {
-      const DroneFacts f{.id = i, .tick = tick, .sim_time_s = t, .state = swarm.state(i),
-                         .rotor_rad_s = swarm.rotor_speeds(i), .server_failsafe = failsafe.active(i),
-                         .phase = tick_phase[i], .agent_live = tick_live[i] != 0,
-                         .motors_on = applied[i].motors_on, .command_age_s = cmd_age_s[i]};
+      const DroneFacts f{.id = i,
+                         .tick = tick,
+                         .sim_time_s = t,
+                         .state = swarm.state(i),
+                         .rotor_rad_s = swarm.rotor_speeds(i),
+                         .server_failsafe = failsafe.active(i),
+                         .phase = tick_phase[i],
+                         .agent_live = tick_live[i] != 0,
+                         .motors_on = applied[i].motors_on,
+                         .command_age_s = cmd_age_s[i]};
       fill_drone_state(swarm_msg.drones()[i], f, collisions, cfg.scene, cfg.sim.airborne_height_m);
       if (scan_tick) {
         swarm.cast_rays(i, cfg.sensors, ranges, hits);
@@ -199,7 +212,8 @@ struct SimServer::Impl {
       else
         referee.note_lost(i);
     }
-    for (auto& b : swarm_msg.beacons()) b.true_position(swarm_msg.drones()[b.drone_id()].position());
+    for (auto& b : swarm_msg.beacons())
+      b.true_position(swarm_msg.drones()[b.drone_id()].position());
     const bool task_changed = referee.update(t, counted.positions, counted.velocities, counted.ids,
                                              cfg.sim.task_timeout_s);
     out.swarm(swarm_msg);
@@ -224,7 +238,8 @@ struct SimServer::Impl {
     // So does a newly accepted mission command or a new phase: they confirm
     // the command, and its progress, to a ground station that never got that
     // agent's ack or heartbeats.
-    if (!out.status_due(force, in.status_due.load(std::memory_order_relaxed), now, sim_time())) return;
+    if (!out.status_due(force, in.status_due.load(std::memory_order_relaxed), now, sim_time()))
+      return;
     msg::SimStatus s;
     {
       std::lock_guard<std::mutex> lock(in.mu);
@@ -306,7 +321,8 @@ struct SimServer::Impl {
         // its answer into this step; the deadline of the next period stays.
         const TickBarrier& b = in.agents.barrier();
         if (b.waiting() > 0 && grace.count() > 0)
-          in.cv.wait_until(lock, next + grace, [&] { return b.waiting() == 0 || stop_requested(); });
+          in.cv.wait_until(lock, next + grace,
+                           [&] { return b.waiting() == 0 || stop_requested(); });
       }
       if (rt_pipelined)
         step();
@@ -332,8 +348,8 @@ struct SimServer::Impl {
         in.expire_agents(wall_seconds());
         // Lockstep: every live agent has answered the published tick.
         bool answered = in.agents.barrier().waiting() == 0;
-        bool idle = cfg.sim.pause_when_idle && answered && in.agents.idle() && !in.missions.pending() &&
-                    !referee.running();
+        bool idle = cfg.sim.pause_when_idle && answered && in.agents.idle() &&
+                    !in.missions.pending() && !referee.running();
         bool was_paused = paused;
         paused = idle;
         state_text = paused ? "paused: swarm idle" : answered ? "running" : "waiting for agents";
@@ -376,7 +392,8 @@ struct SimServer::Impl {
         cfg.scenario.name, n, to_string(cfg.scenario.mode),
         pipelined || rt_pipelined ? " (pipelined: commands act one tick later)" : "",
         cfg.sim.physics_rate_hz, cfg.sim.control_rate_hz, cfg.scenario.seed);
-    if (!cfg.generated_world.empty()) spdlog::info("ddswarm-sim: generated world: {}", cfg.generated_world);
+    if (!cfg.generated_world.empty())
+      spdlog::info("ddswarm-sim: generated world: {}", cfg.generated_world);
     if (cfg.wind.enabled())
       spdlog::info("ddswarm-sim: wind {:.1f} m/s{}{}", cfg.wind.steady_mps.norm(),
                    cfg.wind.turbulence ? ", Dryden turbulence" : "",

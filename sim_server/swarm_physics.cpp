@@ -3,8 +3,9 @@
 namespace ddswarm::sim {
 
 SwarmPhysics::SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor,
-                           const ControllerConfig& controller, const std::vector<Eigen::Vector3d>& starts,
-                           std::uint64_t seed, const WindConfig& wind, const AeroConfig& aero)
+                           const ControllerConfig& controller,
+                           const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed,
+                           const WindConfig& wind, const AeroConfig& aero)
     : world_(scene, quadrotor, starts, scene.start.yaw_rad), wind_(wind, seed) {
   world_.set_aero(aero);
   const int n = static_cast<int>(starts.size());
@@ -16,8 +17,8 @@ SwarmPhysics::SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quad
   }
 }
 
-std::vector<ContactEvent> SwarmPhysics::step(const std::vector<VelocitySetpoint>& setpoints, int substeps,
-                                             double dt_s) {
+std::vector<ContactEvent> SwarmPhysics::step(const std::vector<VelocitySetpoint>& setpoints,
+                                             int substeps, double dt_s) {
   const int n = static_cast<int>(controllers_.size());
   if (wind_.enabled()) {
     const double t = world_.time_s();

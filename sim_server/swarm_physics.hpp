@@ -22,15 +22,16 @@ class SwarmPhysics {
   /// starts: one per drone, m; every drone starts level at yaw scene.start.yaw_rad.
   /// seed: the scenario's; each drone's sensor noise has its own generator.
   /// wind and aero: calm and off unless asked (sim/wind.hpp, sim/aero.hpp).
-  SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor, const ControllerConfig& controller,
-               const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed, const WindConfig& wind = {},
-               const AeroConfig& aero = {});
+  SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor,
+               const ControllerConfig& controller, const std::vector<Eigen::Vector3d>& starts,
+               std::uint64_t seed, const WindConfig& wind = {}, const AeroConfig& aero = {});
 
   /// Steps one control period: substeps physics steps of dt_s s, drone i
   /// flying setpoints[i]. The wind at each drone is taken once a period, at
   /// its start (its turbulence changes over seconds, a period is 20 ms).
   /// Returns the contacts that began, in step order.
-  std::vector<ContactEvent> step(const std::vector<VelocitySetpoint>& setpoints, int substeps, double dt_s);
+  std::vector<ContactEvent> step(const std::vector<VelocitySetpoint>& setpoints, int substeps,
+                                 double dt_s);
 
   RigidState state(int drone) const { return world_.state(drone); }
   /// rad/s, actual (lagged) rotor speeds.

@@ -5,7 +5,8 @@
 
 namespace ddswarm::sim {
 
-void TaskReferee::start(std::uint32_t seq, double t, double epsilon_m, double speed_mps, int drones) {
+void TaskReferee::start(std::uint32_t seq, double t, double epsilon_m, double speed_mps,
+                        int drones) {
   r_ = TaskReport{};
   r_.seq = seq;
   r_.phase = TaskPhase::kRunning;
@@ -19,8 +20,8 @@ void TaskReferee::start(std::uint32_t seq, double t, double epsilon_m, double sp
   r_.metrics = metrics_.summary();
 }
 
-void TaskReferee::on_mission(MissionType type, std::uint32_t seq, double speed_mps, double epsilon_m,
-                             double d_int_m, double sim_time_s, int drones) {
+void TaskReferee::on_mission(MissionType type, std::uint32_t seq, double speed_mps,
+                             double epsilon_m, double d_int_m, double sim_time_s, int drones) {
   if (running() && (type == MissionType::kLand || type == MissionType::kTask ||
                     type == MissionType::kMove || type == MissionType::kFollowLeader))
     fail(std::string("aborted by ") + to_string(type) + " command");
@@ -64,8 +65,10 @@ bool TaskReferee::update(double t, const std::vector<Eigen::Vector3d>& p,
   r_.min_inter_drone_m = std::min(r_.min_inter_drone_m, tick.min_distance_m);
   for (const auto& q : p) r_.min_clearance_m = std::min(r_.min_clearance_m, scene_.clearance(q));
   r_.max_pair_distance_m = max_pair;
-  r_.past_finish = static_cast<int>(std::count_if(
-      p.begin(), p.end(), [&](const Eigen::Vector3d& q) { return scene_.past_finish(q.head<2>()); }));
+  r_.past_finish =
+      static_cast<int>(std::count_if(p.begin(), p.end(), [&](const Eigen::Vector3d& q) {
+        return scene_.past_finish(q.head<2>());
+      }));
   if (p.empty()) {
     r_.phase = TaskPhase::kFailed;
     r_.reason = "no drone left";

@@ -79,8 +79,8 @@ class TaskReferee {
   /// command aborts a running task; a task command (seq) starts one over the
   /// drones at speed_mps, within epsilon_m (m; 0: default_epsilon of d_int_m,
   /// the inter-drone distance in force).
-  void on_mission(MissionType type, std::uint32_t seq, double speed_mps, double epsilon_m, double d_int_m,
-                  double sim_time_s, int drones);
+  void on_mission(MissionType type, std::uint32_t seq, double speed_mps, double epsilon_m,
+                  double d_int_m, double sim_time_s, int drones);
   /// Stops a running task as failed with reason (e.g. "aborted by land").
   void fail(const std::string& reason);
   /// One tick: the drones that count (lost drones excluded by the caller),

@@ -149,7 +149,8 @@ TEST(TaskReferee, AMissionCommandStartsOrAbortsTheTask) {
   EXPECT_TRUE(r.running());
   r.on_mission(MissionType::kLand, 10, 0.0, 0.0, 3.0, 14.0, 6);
   EXPECT_EQ(r.report().phase, TaskPhase::kFailed);
-  EXPECT_EQ(r.report().reason, std::string("aborted by ") + to_string(MissionType::kLand) + " command");
+  EXPECT_EQ(r.report().reason,
+            std::string("aborted by ") + to_string(MissionType::kLand) + " command");
   // Another task command starts a new task (epsilon given) ...
   r.on_mission(MissionType::kTask, 11, 1.0, 9.5, 3.0, 15.0, 6);
   EXPECT_TRUE(r.running());

@@ -17,10 +17,10 @@ namespace ddswarm::sim {
 
 /// The part of a drone's agent record that decides its setpoint for one period.
 struct CommandView {
-  VelocitySetpoint setpoint;      ///< last accepted command (world frame, m/s, rad/s)
-  bool has_command = false;       ///< any command accepted yet
-  std::uint64_t command_tick = 0; ///< the tick that command answered
-  bool live = false;              ///< its agent is live
+  VelocitySetpoint setpoint;       ///< last accepted command (world frame, m/s, rad/s)
+  bool has_command = false;        ///< any command accepted yet
+  std::uint64_t command_tick = 0;  ///< the tick that command answered
+  bool live = false;               ///< its agent is live
 };
 
 /// How answers fly.

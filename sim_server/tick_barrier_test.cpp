@@ -71,7 +71,8 @@ TEST(TickBarrier, AJoinerOwesTheTickAndALostAgentOwesNothing) {
   const int owed_prev = b.unanswered_prev();
   b.join(1);
   EXPECT_EQ(b.waiting(), 1);
-  EXPECT_EQ(b.unanswered_prev(), owed_prev);  // it owes nothing to a tick published before it was heard
+  EXPECT_EQ(b.unanswered_prev(),
+            owed_prev);  // it owes nothing to a tick published before it was heard
   // Agent 1 is lost before answering: nothing is owed any more.
   b.lose(1);
   EXPECT_EQ(b.waiting(), 0);

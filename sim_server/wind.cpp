@@ -37,7 +37,8 @@ double dryden_wavenumber(bool longitudinal, double L, std::uint64_t& s) {
 
 void check_ordered(const std::string& field, const Eigen::Vector2d& v) {
   if (!(v.x() > 0 && v.y() >= v.x()))
-    throw FieldError(field, "[" + to_text(v.x()) + ", " + to_text(v.y()) + "]", "must be [min, max] with 0 < min <= max");
+    throw FieldError(field, "[" + to_text(v.x()) + ", " + to_text(v.y()) + "]",
+                     "must be [min, max] with 0 < min <= max");
 }
 
 }  // namespace
@@ -48,9 +49,10 @@ void WindConfig::validate() const {
   if (!steady_mps.allFinite())
     throw FieldError("wind.steady_mps", to_text(steady_mps.transpose()), "must be finite");
   if (turbulence && steady_mps.norm() < 0.1)
-    throw FieldError("wind.turbulence", "true",
-                     "Dryden turbulence takes its intensity and length scales from the mean wind: set "
-                     "wind.steady_mps (its size is the wind at 6 m) to at least 0.1 m/s");
+    throw FieldError(
+        "wind.turbulence", "true",
+        "Dryden turbulence takes its intensity and length scales from the mean wind: set "
+        "wind.steady_mps (its size is the wind at 6 m) to at least 0.1 m/s");
   if (gusts_per_minute > 0) {
     check_ordered("wind.gust_amplitude_mps", gust_amplitude_mps);
     check_ordered("wind.gust_duration_s", gust_duration_s);
@@ -86,10 +88,12 @@ WindField::WindField(const WindConfig& c, std::uint64_t seed) : cfg_(c), enabled
   world_from_wind_.col(1) = Eigen::Vector3d::UnitZ().cross(along);
   world_from_wind_.col(2) = Eigen::Vector3d::UnitZ();
   gust_state_ = seed ^ 0x6a09e667f3bcc909ULL;
-  next_gust_s_ = c.gusts_per_minute > 0 ? -std::log(unit(gust_state_)) * 60.0 / c.gusts_per_minute : 1e300;
+  next_gust_s_ =
+      c.gusts_per_minute > 0 ? -std::log(unit(gust_state_)) * 60.0 / c.gusts_per_minute : 1e300;
   if (!c.turbulence) return;
   scales_ = dryden_scales(mean_speed_, c.turbulence_altitude_m);
-  const double sigma[3] = {scales_.sigma_u * c.turbulence_scale, scales_.sigma_v * c.turbulence_scale,
+  const double sigma[3] = {scales_.sigma_u * c.turbulence_scale,
+                           scales_.sigma_v * c.turbulence_scale,
                            scales_.sigma_w * c.turbulence_scale};
   const double L[3] = {scales_.L_u, scales_.L_v, scales_.L_w};
   for (int comp = 0; comp < 3; ++comp) {
@@ -132,8 +136,11 @@ void WindField::advance_to(double t) {
   while (next_gust_s_ <= t + ahead) {
     Gust g;
     g.t_s = next_gust_s_;
-    g.amplitude_mps = cfg_.gust_amplitude_mps.x() + (cfg_.gust_amplitude_mps.y() - cfg_.gust_amplitude_mps.x()) * unit(gust_state_);
-    g.duration_s = cfg_.gust_duration_s.x() + (cfg_.gust_duration_s.y() - cfg_.gust_duration_s.x()) * unit(gust_state_);
+    g.amplitude_mps =
+        cfg_.gust_amplitude_mps.x() +
+        (cfg_.gust_amplitude_mps.y() - cfg_.gust_amplitude_mps.x()) * unit(gust_state_);
+    g.duration_s = cfg_.gust_duration_s.x() +
+                   (cfg_.gust_duration_s.y() - cfg_.gust_duration_s.x()) * unit(gust_state_);
     gusts_.push_back(g);
     next_gust_s_ += -std::log(unit(gust_state_)) * 60.0 / cfg_.gusts_per_minute;
   }
@@ -151,7 +158,8 @@ Eigen::Vector3d WindField::gust(const Eigen::Vector3d& p, double t) const {
   double a = 0;
   for (; it != gusts_.end() && it->t_s <= t - delay; ++it) {
     const double tau = t - it->t_s - delay;
-    if (tau <= it->duration_s) a += 0.5 * it->amplitude_mps * (1 - std::cos(2 * kPi * tau / it->duration_s));
+    if (tau <= it->duration_s)
+      a += 0.5 * it->amplitude_mps * (1 - std::cos(2 * kPi * tau / it->duration_s));
   }
   return a * world_from_wind_.col(0);
 }

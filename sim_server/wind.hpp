@@ -48,19 +48,28 @@ struct WindConfig {
 
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    v.field("steady_mps", c.steady_mps, {"m/s", any(), "the mean wind, world ENU (its size is W20, the wind at 6 m)"});
-    v.field("turbulence", c.turbulence, {"", any(), "Dryden turbulence from the mean wind (MIL-HDBK-1797, low altitude)"});
+    v.field("steady_mps", c.steady_mps,
+            {"m/s", any(), "the mean wind, world ENU (its size is W20, the wind at 6 m)"});
+    v.field("turbulence", c.turbulence,
+            {"", any(), "Dryden turbulence from the mean wind (MIL-HDBK-1797, low altitude)"});
     v.field("turbulence_altitude_m", c.turbulence_altitude_m,
             {"m", in(3.05, 300), "the altitude the length scales and intensities are taken at"});
-    v.field("turbulence_scale", c.turbulence_scale, {"", in(0, 10), "multiplies the Dryden intensities"});
-    v.field("turbulence_modes", c.turbulence_modes, {"", in(8, 1024), "Fourier modes per component"});
-    v.field("gusts_per_minute", c.gusts_per_minute, {"1/min", in(0, 600), "mean rate of 1-cosine gusts; 0 = none"});
-    v.field("gust_amplitude_mps", c.gust_amplitude_mps, {"m/s", any(), "[min, max] peak speed, 0 < min <= max"});
-    v.field("gust_duration_s", c.gust_duration_s, {"s", any(), "[min, max] length, 0 < min <= max"});
+    v.field("turbulence_scale", c.turbulence_scale,
+            {"", in(0, 10), "multiplies the Dryden intensities"});
+    v.field("turbulence_modes", c.turbulence_modes,
+            {"", in(8, 1024), "Fourier modes per component"});
+    v.field("gusts_per_minute", c.gusts_per_minute,
+            {"1/min", in(0, 600), "mean rate of 1-cosine gusts; 0 = none"});
+    v.field("gust_amplitude_mps", c.gust_amplitude_mps,
+            {"m/s", any(), "[min, max] peak speed, 0 < min <= max"});
+    v.field("gust_duration_s", c.gust_duration_s,
+            {"s", any(), "[min, max] length, 0 < min <= max"});
     v.field("seed", c.seed, {"", any(), "the wind's seed; 0 = scenario.seed"});
   }
 
-  bool enabled() const { return steady_mps.squaredNorm() > 0 || turbulence || gusts_per_minute > 0; }
+  bool enabled() const {
+    return steady_mps.squaredNorm() > 0 || turbulence || gusts_per_minute > 0;
+  }
   /// Bounds from the field list, then: turbulence needs a mean wind, gust ranges ordered.
   void validate() const;  ///< throws FieldError("wind.…")
 };
@@ -74,7 +83,7 @@ DrydenScales dryden_scales(double w20_mps, double h_m);
 
 /// One gust of the seeded schedule.
 struct Gust {
-  double t_s;          ///< when its front passes the origin
+  double t_s;  ///< when its front passes the origin
   double amplitude_mps;
   double duration_s;
 };
@@ -101,7 +110,7 @@ class WindField {
   struct Mode {
     Eigen::Vector3d k;  ///< rad/m, in the wind frame (along, across, up)
     double phase;
-    double amplitude;   ///< m/s
+    double amplitude;  ///< m/s
   };
   Eigen::Vector3d to_wind_frame(const Eigen::Vector3d& p_world, double t) const;
 

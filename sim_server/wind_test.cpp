@@ -25,7 +25,8 @@ WindConfig turbulent(double w20, double h_m = 3.05) {
 }
 
 /// Correlation of the along-wind turbulence at a and b over a long run, over several seeds.
-double correlation(const WindConfig& c, const Vector3d& a, const Vector3d& b, double dt_s, int comp = 0) {
+double correlation(const WindConfig& c, const Vector3d& a, const Vector3d& b, double dt_s,
+                   int comp = 0) {
   double sab = 0, saa = 0, sbb = 0;
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
     const WindField f(c, seed);
@@ -110,7 +111,8 @@ TEST(Wind, ASeedIsAWind) {
     EXPECT_EQ(a.at(Vector3d(1, 2, 3), t), b.at(Vector3d(1, 2, 3), t));
   }
   EXPECT_NE(a.at(Vector3d(1, 2, 3), 50), other.at(Vector3d(1, 2, 3), 50));
-  EXPECT_EQ(WindField(WindConfig{}, 1).at(Vector3d(1, 2, 3), 5), Vector3d::Zero()) << "calm by default";
+  EXPECT_EQ(WindField(WindConfig{}, 1).at(Vector3d(1, 2, 3), 5), Vector3d::Zero())
+      << "calm by default";
 }
 
 TEST(Wind, AGustHasTheOneCosineShapeAndTravelsWithTheWind) {
@@ -127,7 +129,8 @@ TEST(Wind, AGustHasTheOneCosineShapeAndTravelsWithTheWind) {
   for (double tau = 0; tau <= 2.0; tau += 0.1) {
     const double want = 1.5 * (1 - std::cos(M_PI * tau));
     EXPECT_NEAR(f.gust(origin, g.t_s + tau).x(), want, 1e-9) << tau;
-    EXPECT_NEAR(f.gust(downwind, g.t_s + 2.0 + tau).x(), want, 1e-9) << "10 m downwind at 5 m/s: 2 s later";
+    EXPECT_NEAR(f.gust(downwind, g.t_s + 2.0 + tau).x(), want, 1e-9)
+        << "10 m downwind at 5 m/s: 2 s later";
   }
   EXPECT_NEAR(f.gust(origin, g.t_s + 1.0).x(), 3.0, 1e-12) << "its peak, halfway";
   EXPECT_EQ(f.gust(origin, g.t_s + 1.0).y(), 0) << "along the mean wind";
@@ -150,7 +153,8 @@ TEST(Wind, BadInputNamesTheField) {
   };
   WindConfig c;
   c.turbulence = true;
-  EXPECT_NE(error(c).find("wind.turbulence = true: Dryden turbulence takes its intensity"), std::string::npos);
+  EXPECT_NE(error(c).find("wind.turbulence = true: Dryden turbulence takes its intensity"),
+            std::string::npos);
   c = WindConfig{};
   c.gusts_per_minute = 2;
   c.gust_duration_s = {3, 1};
@@ -161,8 +165,10 @@ TEST(Wind, BadInputNamesTheField) {
 }
 
 TEST(Wind, TheReferenceDescribesEveryField) {
-  EXPECT_EQ(reference_mismatches(configuration_reference(), "### `wind:`", field_rows<WindConfig>()),
-            std::vector<std::string>{});
-  EXPECT_EQ(reference_mismatches(configuration_reference(), "### `aero:`", field_rows<AeroConfig>()),
-            std::vector<std::string>{});
+  EXPECT_EQ(
+      reference_mismatches(configuration_reference(), "### `wind:`", field_rows<WindConfig>()),
+      std::vector<std::string>{});
+  EXPECT_EQ(
+      reference_mismatches(configuration_reference(), "### `aero:`", field_rows<AeroConfig>()),
+      std::vector<std::string>{});
 }

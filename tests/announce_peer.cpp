@@ -18,7 +18,8 @@ int main(int argc, char** argv) {
   return run_main("announce_peer", [&]() -> int {
     CLI::App app{"a participant that counts whom it matched"};
     DdsConfig dds;
-    dds.shared_memory = false;  // unicast pings are all the discovery there is, as under DDS Security
+    dds.shared_memory =
+        false;  // unicast pings are all the discovery there is, as under DDS Security
     double time_s = 5;
     std::string name = "announce_peer";
     app.add_option("--domain", dds.domain_id);

@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
     auto w_coll = p.writer<msg::CollisionEvent>();
     auto w_ack = p.writer<msg::MissionAck>();
     auto w_swarm = p.writer<msg::SwarmState>();
-    for (int i = 0; i < 100 && (w_coll.matched() < 1 || w_ack.matched() < 1 || w_swarm.matched() < 1); ++i)
+    for (int i = 0;
+         i < 100 && (w_coll.matched() < 1 || w_ack.matched() < 1 || w_swarm.matched() < 1); ++i)
       wait_for_stop(std::chrono::milliseconds(100));
     if (w_coll.matched() < 1) throw std::runtime_error("no recorder matched");
     // Matching completes on the reader side a moment later; keep-last QoS could

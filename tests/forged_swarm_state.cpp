@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
       f.drones()[0].flags(msg::DRONE_AGENT_LIVE | msg::DRONE_AIRBORNE);
       // Odd samples: NaN position; even: a plausible state 50 m away. After a
       // copied scene, every one is plausible: 1 m below the height held.
-      f.drones()[0].position(to_msg(plausible ? Eigen::Vector3d(0, 0, z - 1)
+      f.drones()[0].position(to_msg(plausible  ? Eigen::Vector3d(0, 0, z - 1)
                                     : sent % 2 ? Eigen::Vector3d(nan, nan, nan)
                                                : Eigen::Vector3d(50, 0, 2)));
       w.write(f);

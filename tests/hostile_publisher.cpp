@@ -11,8 +11,8 @@
 // Exit 0 when every matching SimStatus rejected_* counter grew, no hostile
 // mission was forwarded, and the drone kept hovering (height within the
 // tolerance, no horizontal drift, no absurd speed, no failsafe, its agent live).
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -73,10 +73,11 @@ msg::VelocityCommand command(int id, std::uint64_t tick, const Eigen::Vector3d& 
 void print_counters(const char* label, const msg::SimStatus& s) {
   std::printf(
       "%s: tick %llu non_finite %u absurd %u unknown_id %u stale_tick %u future_tick %u "
-      "impostor %u mission %u commands_applied %llu commands_late %llu agents_live %u failsafe %u\n",
-      label, static_cast<unsigned long long>(s.tick()), s.rejected_non_finite(), s.rejected_absurd(),
-      s.rejected_unknown_id(), s.rejected_stale_tick(), s.rejected_future_tick(),
-      s.rejected_impostor(), s.rejected_mission(),
+      "impostor %u mission %u commands_applied %llu commands_late %llu agents_live %u failsafe "
+      "%u\n",
+      label, static_cast<unsigned long long>(s.tick()), s.rejected_non_finite(),
+      s.rejected_absurd(), s.rejected_unknown_id(), s.rejected_stale_tick(),
+      s.rejected_future_tick(), s.rejected_impostor(), s.rejected_mission(),
       static_cast<unsigned long long>(s.commands_applied()),
       static_cast<unsigned long long>(s.commands_late()), s.agents_live(), s.failsafe());
 }
@@ -108,7 +109,8 @@ int main(int argc, char** argv) {
 
     p.reader<msg::AgentStatus>([&](const msg::AgentStatus& a, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
-      if (a.drone_id() == id && a.agent_instance() != kImpostor && !w.owner) w.owner = a.agent_instance();
+      if (a.drone_id() == id && a.agent_instance() != kImpostor && !w.owner)
+        w.owner = a.agent_instance();
     });
     p.reader<msg::SimStatus>([&](const msg::SimStatus& s, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
@@ -151,14 +153,15 @@ int main(int argc, char** argv) {
       {
         std::lock_guard<std::mutex> lock(mu);
         if (w.owner && w.agent_live && w.status && w.stable_since_wall >= 0 &&
-            wall_seconds() - w.stable_since_wall > 1.0 && w_cmd.matched() > 0 && w_mission.matched() > 0)
+            wall_seconds() - w.stable_since_wall > 1.0 && w_cmd.matched() > 0 &&
+            w_mission.matched() > 0)
           break;
         if (stop_requested() || wall_seconds() - t0 > timeout_s) {
-          std::printf("FAIL: drone %d never hovered at %.2f m under a live agent within %.0f s "
-                      "(owner %016llx, live %d, z %.3f, status %d, writers matched %d/%d)\n",
-                      id, target_z, timeout_s, static_cast<unsigned long long>(w.owner),
-                      w.agent_live, w.p_world.z(), w.status.has_value(), w_cmd.matched(),
-                      w_mission.matched());
+          std::printf(
+              "FAIL: drone %d never hovered at %.2f m under a live agent within %.0f s "
+              "(owner %016llx, live %d, z %.3f, status %d, writers matched %d/%d)\n",
+              id, target_z, timeout_s, static_cast<unsigned long long>(w.owner), w.agent_live,
+              w.p_world.z(), w.status.has_value(), w_cmd.matched(), w_mission.matched());
           return 1;
         }
       }
@@ -234,7 +237,8 @@ int main(int argc, char** argv) {
     }
     wait_for_stop(std::chrono::milliseconds(1000));
     std::optional<msg::SimStatus> after;
-    for (double t = wall_seconds(); wall_seconds() - t < 3.0; wait_for_stop(std::chrono::milliseconds(50))) {
+    for (double t = wall_seconds(); wall_seconds() - t < 3.0;
+         wait_for_stop(std::chrono::milliseconds(50))) {
       std::lock_guard<std::mutex> lock(mu);
       if (w.status && w.status->tick() > end_tick) {
         after = w.status;
@@ -243,27 +247,30 @@ int main(int argc, char** argv) {
     }
     std::lock_guard<std::mutex> lock(mu);
     w.observing = false;
-    std::printf("%d attack rounds (%d velocity commands, %u mission commands)\n", rounds, rounds * 8,
-                seq - 1);
+    std::printf("%d attack rounds (%d velocity commands, %u mission commands)\n", rounds,
+                rounds * 8, seq - 1);
     if (!after) {
       std::printf("FAIL: no SimStatus after the attack\n");
       return 1;
     }
     print_counters("after", *after);
-    std::printf("drone %d over %d samples: max |z-%.2f| %.4f m, max horizontal drift %.4f m, "
-                "max speed %.4f m/s, max command age %.3f s, failsafe samples %d, "
-                "agent-not-live samples %d, non-finite samples %d\n",
-                id, w.samples, target_z, w.max_dz, w.max_drift_xy, w.max_speed, w.max_command_age_s,
-                w.failsafe_samples, w.not_live_samples, w.non_finite_samples);
+    std::printf(
+        "drone %d over %d samples: max |z-%.2f| %.4f m, max horizontal drift %.4f m, "
+        "max speed %.4f m/s, max command age %.3f s, failsafe samples %d, "
+        "agent-not-live samples %d, non-finite samples %d\n",
+        id, w.samples, target_z, w.max_dz, w.max_drift_xy, w.max_speed, w.max_command_age_s,
+        w.failsafe_samples, w.not_live_samples, w.non_finite_samples);
 
     std::vector<std::string> failures;
     // The legitimate agent alone must never trip the gate.
     if (before.rejected_non_finite() + before.rejected_absurd() + before.rejected_unknown_id() +
-            before.rejected_stale_tick() + before.rejected_future_tick() + before.rejected_impostor() +
-            before.rejected_mission() > 0)
+            before.rejected_stale_tick() + before.rejected_future_tick() +
+            before.rejected_impostor() + before.rejected_mission() >
+        0)
       failures.push_back("the legitimate agent's own samples were rejected before the attack");
     auto grew = [&](const char* name, std::uint64_t b, std::uint64_t a) {
-      if (a <= b) failures.push_back(fmt::format("rejected_{} did not grow ({} -> {})", name, b, a));
+      if (a <= b)
+        failures.push_back(fmt::format("rejected_{} did not grow ({} -> {})", name, b, a));
     };
     grew("non_finite", before.rejected_non_finite(), after->rejected_non_finite());
     grew("absurd", before.rejected_absurd(), after->rejected_absurd());
@@ -277,18 +284,21 @@ int main(int argc, char** argv) {
     if (w.samples < 10) failures.push_back(fmt::format("only {} drone samples watched", w.samples));
     if (w.non_finite_samples) failures.push_back("the drone's state became non-finite");
     if (w.max_dz > tolerance)
-      failures.push_back(fmt::format("height left {:.2f} +- {:.2f} m (max error {:.3f} m)", target_z,
-                                     tolerance, w.max_dz));
+      failures.push_back(fmt::format("height left {:.2f} +- {:.2f} m (max error {:.3f} m)",
+                                     target_z, tolerance, w.max_dz));
     if (w.max_drift_xy > tolerance)
       failures.push_back(fmt::format("drifted {:.3f} m sideways", w.max_drift_xy));
     if (w.max_speed > max_speed)
       failures.push_back(fmt::format("moved at {:.3f} m/s (limit {:.2f})", w.max_speed, max_speed));
     if (w.failsafe_samples)
-      failures.push_back(fmt::format("drone in failsafe for {} samples: legitimate commands were starved",
-                                     w.failsafe_samples));
+      failures.push_back(
+          fmt::format("drone in failsafe for {} samples: legitimate commands were starved",
+                      w.failsafe_samples));
     if (w.not_live_samples)
-      failures.push_back(fmt::format("legitimate agent not live for {} samples", w.not_live_samples));
-    if (w.hostile_mission_forwarded) failures.push_back("a hostile mission command was forwarded to agents");
+      failures.push_back(
+          fmt::format("legitimate agent not live for {} samples", w.not_live_samples));
+    if (w.hostile_mission_forwarded)
+      failures.push_back("a hostile mission command was forwarded to agents");
     for (const auto& f : failures) std::printf("FAIL: %s\n", f.c_str());
     return failures.empty() ? 0 : 1;
   });

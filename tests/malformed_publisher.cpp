@@ -9,8 +9,8 @@
 // the generated type support, then one byte is changed; the writers copy the
 // QoS and partitions of the project's own writers, so they match as any
 // participant's would. Exits 0 once it has published everything.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -50,8 +50,10 @@ std::size_t bool_offset(void (T::*set)(bool)) {
   T a, b;
   (a.*set)(false);
   (b.*set)(true);
-  rtps::SerializedPayload_t pa(type.getSerializedSizeProvider(&a)()), pb(type.getSerializedSizeProvider(&b)());
-  if (!type.serialize(&a, &pa) || !type.serialize(&b, &pb)) throw std::runtime_error("cannot serialise");
+  rtps::SerializedPayload_t pa(type.getSerializedSizeProvider(&a)()),
+      pb(type.getSerializedSizeProvider(&b)());
+  if (!type.serialize(&a, &pa) || !type.serialize(&b, &pb))
+    throw std::runtime_error("cannot serialise");
   for (std::size_t i = 0; i < pa.length && i < pb.length; ++i)
     if (pa.data[i] != pb.data[i]) return i;
   throw std::runtime_error("bool field not found in the payload");
@@ -60,13 +62,16 @@ std::size_t bool_offset(void (T::*set)(bool)) {
 /// A writer on `topic_name` with the QoS and partitions of `like`, whose
 /// samples are corrupted at `offset`.
 template <class T>
-fdds::DataWriter* corrupt_writer(fdds::DomainParticipant* dp, fdds::DataWriter* like, std::size_t offset) {
+fdds::DataWriter* corrupt_writer(fdds::DomainParticipant* dp, fdds::DataWriter* like,
+                                 std::size_t offset) {
   fdds::TypeSupport ts(new Corrupting<T>(offset, 2));
-  if (ts.register_type(dp) != ReturnCode_t::RETCODE_OK) throw std::runtime_error("cannot register type");
+  if (ts.register_type(dp) != ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("cannot register type");
   auto* topic = dp->create_topic(Topic<T>::name, ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
   auto* pub = topic ? dp->create_publisher(like->get_publisher()->get_qos()) : nullptr;
   auto* w = pub ? pub->create_datawriter(topic, like->get_qos()) : nullptr;
-  if (!w) throw std::runtime_error(std::string("cannot create a corrupting writer on ") + Topic<T>::name);
+  if (!w)
+    throw std::runtime_error(std::string("cannot create a corrupting writer on ") + Topic<T>::name);
   return w;
 }
 
@@ -91,8 +96,10 @@ int main(int argc, char** argv) {
     // A second participant (localhost-only like every Participant) registers
     // the corrupting type support under the real type names.
     Participant p(dds, "malformed_publisher");
-    auto* cmd = corrupt_writer<msg::VelocityCommand>(p.raw(), w_cmd.raw(), bool_offset(&msg::VelocityCommand::motors_on));
-    auto* hb = corrupt_writer<msg::AgentStatus>(p.raw(), w_hb.raw(), bool_offset(&msg::AgentStatus::server_lost));
+    auto* cmd = corrupt_writer<msg::VelocityCommand>(p.raw(), w_cmd.raw(),
+                                                     bool_offset(&msg::VelocityCommand::motors_on));
+    auto* hb = corrupt_writer<msg::AgentStatus>(p.raw(), w_hb.raw(),
+                                                bool_offset(&msg::AgentStatus::server_lost));
 
     // Wait for the server's readers to match.
     const double t0 = wall_seconds();
@@ -103,7 +110,8 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
     if (st.current_count == 0) {
-      std::fprintf(stderr, "malformed_publisher: no reader matched the command writer within 10 s\n");
+      std::fprintf(stderr,
+                   "malformed_publisher: no reader matched the command writer within 10 s\n");
       return 1;
     }
     int sent = 0;

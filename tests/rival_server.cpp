@@ -43,8 +43,8 @@ int main(int argc, char** argv) {
     t.nanosec = static_cast<std::uint32_t>(ns % 1000000000);
     if (scenes.raw()->write_w_timestamp(&scene, fdds::HANDLE_NIL, t) != ReturnCode_t::RETCODE_OK)
       throw std::runtime_error("the scene was not written");
-    std::printf("rival server %016llx: scene stamped %+.0f s\n", static_cast<unsigned long long>(me),
-                offset_s);
+    std::printf("rival server %016llx: scene stamped %+.0f s\n",
+                static_cast<unsigned long long>(me), offset_s);
     std::fflush(stdout);
     msg::SimStatus s;
     s.server_instance(me);

@@ -1,8 +1,8 @@
 // A test helper that talks plain DDS, no agent code: it flies drone 0 to a
 // target with a proportional velocity law and reports how well it hovers.
 // Exit 0 when the drone held the target within the tolerance.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <atomic>
 #include <cmath>

@@ -36,16 +36,20 @@ int main(int argc, char** argv) {
     bool spoof = false;
     double for_s = 3.0, east_mps = 2.0, wait_match_s = 0;
     add_dds_options(app, dds);
-    app.add_option("--publish", what, "velocity | swarm_state")->check(CLI::IsMember({"velocity", "swarm_state"}));
+    app.add_option("--publish", what, "velocity | swarm_state")
+        ->check(CLI::IsMember({"velocity", "swarm_state"}));
     app.add_option("--drone", drone, "velocity: the drone addressed");
-    app.add_option("--partition", partition, "velocity: the writer's partition (default: drone/K when secure)");
-    app.add_flag("--spoof", spoof, "velocity: carry the drone's live agent instance and the current tick");
+    app.add_option("--partition", partition,
+                   "velocity: the writer's partition (default: drone/K when secure)");
+    app.add_flag("--spoof", spoof,
+                 "velocity: carry the drone's live agent instance and the current tick");
     app.add_option("--east", east_mps, "velocity: m/s east in every command");
     app.add_option("--for", for_s, "wall seconds to publish and listen");
-    app.add_option("--wait-match", wait_match_s,
-                   "first wait up to this many wall seconds for a matched reader (with --spoof, also the "
-                   "drone's heartbeat; when refused, a swarm state), so a slow authentication does not "
-                   "shorten the attack");
+    app.add_option(
+        "--wait-match", wait_match_s,
+        "first wait up to this many wall seconds for a matched reader (with --spoof, also the "
+        "drone's heartbeat; when refused, a swarm state), so a slow authentication does not "
+        "shorten the attack");
     CLI11_PARSE(app, argc, argv);
     install_stop_signals();
 
@@ -58,7 +62,8 @@ int main(int argc, char** argv) {
       tick = std::max(tick, s.tick());
       ++heard_state;
     });
-    p.reader<msg::SimStatus>([&](const msg::SimStatus&, const fdds::SampleInfo&) { ++heard_status; });
+    p.reader<msg::SimStatus>(
+        [&](const msg::SimStatus&, const fdds::SampleInfo&) { ++heard_status; });
     p.reader<msg::AgentStatus>([&](const msg::AgentStatus& a, const fdds::SampleInfo&) {
       std::lock_guard<std::mutex> lock(mu);
       if (a.drone_id() == drone) owner = a.agent_instance();
@@ -70,7 +75,8 @@ int main(int argc, char** argv) {
     bool refused = false;
     try {
       if (what == "velocity")
-        w_cmd.emplace(p.writer<msg::VelocityCommand>(partition.value_or(dds.secure() ? drone_partition(drone) : "")));
+        w_cmd.emplace(p.writer<msg::VelocityCommand>(
+            partition.value_or(dds.secure() ? drone_partition(drone) : "")));
       else
         w_state.emplace(p.writer<msg::SwarmState>());
     } catch (const DdsError& e) {
@@ -115,8 +121,10 @@ int main(int argc, char** argv) {
       }
       wait_for_stop(std::chrono::milliseconds(10));
     }
-    std::printf("probe: writer %s matched=%d sent=%ld heard_state=%d heard_status=%d heard_heartbeats=%d\n",
-                refused ? "refused" : "created", matched, sent, heard_state.load(), heard_status.load(), heard_heartbeats.load());
+    std::printf(
+        "probe: writer %s matched=%d sent=%ld heard_state=%d heard_status=%d heard_heartbeats=%d\n",
+        refused ? "refused" : "created", matched, sent, heard_state.load(), heard_status.load(),
+        heard_heartbeats.load());
     return 0;
   });
 }

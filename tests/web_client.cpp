@@ -6,19 +6,17 @@
 //   web_client ws PORT STEP...                 one WebSocket connection, steps in order:
 //     type=T          read until a message of type T (printed, shortened)
 //     drones=N        read until a frame with N drones, all positions finite
-//     airborne=N      read until a frame with at least N drones flagged airborne (bit 1) and z > 0.2 m
-//     frames=N        read N more frames; live frames must have increasing ticks
-//     send=JSON       send a text message
-//     binary          send a binary message
-//     big=BYTES       send a text message of BYTES bytes
-//     ack=ID:ok|fail  read until the ack for command ID, check ok
-//     error=TEXT      read until an error whose message contains TEXT
-//     replay-t=A:B    read until a frame whose t lies in [A, B] (sim s; A or B may be empty)
-//     replay=KEY:VAL  read until a replay message whose KEY dumps as VAL (e.g. playing:false)
-//     abort           drop the TCP connection without a WebSocket close, exit 0
-//     close           WebSocket close
+//     airborne=N      read until a frame with at least N drones flagged airborne (bit 1) and z >
+//     0.2 m frames=N        read N more frames; live frames must have increasing ticks send=JSON
+//     send a text message binary          send a binary message big=BYTES       send a text message
+//     of BYTES bytes ack=ID:ok|fail  read until the ack for command ID, check ok error=TEXT read
+//     until an error whose message contains TEXT replay-t=A:B    read until a frame whose t lies in
+//     [A, B] (sim s; A or B may be empty) replay=KEY:VAL  read until a replay message whose KEY
+//     dumps as VAL (e.g. playing:false) abort           drop the TCP connection without a WebSocket
+//     close, exit 0 close           WebSocket close
 // Exits 1 on a failed check, 3 on --timeout (default 60 s, env WEB_CLIENT_TIMEOUT).
 #include <utility>  // before Boost 1.74's asio (std::exchange)
+
 #include <boost/asio.hpp>
 #include <boost/beast.hpp>
 #include <chrono>
@@ -46,11 +44,14 @@ namespace {
   std::exit(1);
 }
 
-std::string shorten(const std::string& s, std::size_t n = 200) { return s.size() > n ? s.substr(0, n) + "..." : s; }
+std::string shorten(const std::string& s, std::size_t n = 200) {
+  return s.size() > n ? s.substr(0, n) + "..." : s;
+}
 
 tcp::socket connect(asio::io_context& io, const std::string& port) {
   tcp::socket s(io);
-  s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(std::stoi(port))));
+  s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"),
+                          static_cast<unsigned short>(std::stoi(port))));
   return s;
 }
 
@@ -136,15 +137,16 @@ class Session {
           if ((d["flags"].get<int>() & 1) && d["p"][2].get<double>() > 0.2) ++up;
         return up >= n;
       });
-      std::printf("  tick %llu: %d drones airborne, drone 0 at z %.2f m\n", f["tick"].get<unsigned long long>(), n,
-                  f["drones"][0]["p"][2].get<double>());
+      std::printf("  tick %llu: %d drones airborne, drone 0 at z %.2f m\n",
+                  f["tick"].get<unsigned long long>(), n, f["drones"][0]["p"][2].get<double>());
     } else if (key == "frames") {
       const int n = std::stoi(val);
       long long last = -1;
       for (int i = 0; i < n; ++i) {
         json f = until("frame", [](const json&) { return true; });
         const long long tick = f["tick"].get<long long>();
-        if (live_ && tick <= last) fail("frame tick went from " + std::to_string(last) + " to " + std::to_string(tick));
+        if (live_ && tick <= last)
+          fail("frame tick went from " + std::to_string(last) + " to " + std::to_string(tick));
         last = tick;
       }
       std::printf("  %d frames, last tick %lld\n", n, last);
@@ -166,15 +168,21 @@ class Session {
       const long long id = std::stoll(val.substr(0, colon));
       const bool want_ok = val.substr(colon + 1) == "ok";
       json a = until("ack", [&](const json& j) { return j["id"].get<long long>() == id; });
-      std::printf("  ack %lld: %s %s\n", id, a["ok"].get<bool>() ? "ok" : "FAILED", a["message"].get<std::string>().c_str());
-      if (a["ok"].get<bool>() != want_ok) fail("ack " + std::to_string(id) + " ok != " + (want_ok ? "true" : "false"));
+      std::printf("  ack %lld: %s %s\n", id, a["ok"].get<bool>() ? "ok" : "FAILED",
+                  a["message"].get<std::string>().c_str());
+      if (a["ok"].get<bool>() != want_ok)
+        fail("ack " + std::to_string(id) + " ok != " + (want_ok ? "true" : "false"));
     } else if (key == "error") {
-      until("error", [&](const json& j) { return j["message"].get<std::string>().find(val) != std::string::npos; });
+      until("error", [&](const json& j) {
+        return j["message"].get<std::string>().find(val) != std::string::npos;
+      });
     } else if (key == "replay-t") {
       const auto colon = val.find(':');
       const std::string a = val.substr(0, colon), b = val.substr(colon + 1);
       const double lo = a.empty() ? -1e300 : std::stod(a), hi = b.empty() ? 1e300 : std::stod(b);
-      json f = until("frame", [&](const json& j) { return j["t"].get<double>() >= lo && j["t"].get<double>() <= hi; });
+      json f = until("frame", [&](const json& j) {
+        return j["t"].get<double>() >= lo && j["t"].get<double>() <= hi;
+      });
       std::printf("  frame t %.3f s, %zu drones\n", f["t"].get<double>(), f["drones"].size());
     } else if (key == "replay") {
       const auto colon = val.find(':');

@@ -49,7 +49,8 @@ struct Bucket {
 /// Index of the first element with t > x.
 template <class V>
 std::size_t after(const V& v, double x) {
-  auto it = std::upper_bound(v.begin(), v.end(), x, [](double a, const auto& e) { return a < e.t; });
+  auto it =
+      std::upper_bound(v.begin(), v.end(), x, [](double a, const auto& e) { return a < e.t; });
   return static_cast<std::size_t>(it - v.begin());
 }
 
@@ -57,7 +58,8 @@ std::size_t after(const V& v, double x) {
 
 std::string WebBridgeCounts::line() const {
   return fmt::format(
-      "web: {} client(s), {} frames sent, {} replaced for slow clients, {} malformed messages, {} rate-limited, "
+      "web: {} client(s), {} frames sent, {} replaced for slow clients, {} malformed messages, {} "
+      "rate-limited, "
       "{} commands, {} recordings",
       clients, frames_sent, frames_replaced, malformed, rate_limited, commands, uploads);
 }
@@ -118,8 +120,8 @@ struct WebBridge::Impl {
 
   // ---- counters (read at the end) ----
   struct {
-    std::atomic<std::uint64_t> clients{0}, frames_sent{0}, frames_replaced{0}, malformed{0}, rate_limited{0},
-        commands{0}, uploads{0};
+    std::atomic<std::uint64_t> clients{0}, frames_sent{0}, frames_replaced{0}, malformed{0},
+        rate_limited{0}, commands{0}, uploads{0};
   } n;
 
   // ---- the command worker ----
@@ -144,11 +146,12 @@ struct WebBridge::Impl {
     hooks.on_open = [this](const std::shared_ptr<WebClient>& p) { on_open(p); };
     hooks.on_close = [this](const std::shared_ptr<WebClient>& p) { on_close(p); };
     hooks.on_tick = [this](const std::shared_ptr<WebClient>& p) { on_tick(p); };
-    hooks.on_message = [this](const std::shared_ptr<WebClient>& p, std::string_view t, bool binary) {
-      on_message(p, t, binary);
-    };
+    hooks.on_message = [this](const std::shared_ptr<WebClient>& p, std::string_view t,
+                              bool binary) { on_message(p, t, binary); };
     hooks.on_upload = [this](const std::filesystem::path& f, const std::string& name,
-                             std::function<void(int, std::string)> respond) { on_upload(f, name, std::move(respond)); };
+                             std::function<void(int, std::string)> respond) {
+      on_upload(f, name, std::move(respond));
+    };
     server = std::make_unique<WebServer>(opt.server, std::move(hooks));
     subscribe();
     worker = std::thread([this] { work(); });
@@ -208,18 +211,20 @@ struct WebBridge::Impl {
       std::lock_guard<std::mutex> lock(latest.mu);
       c.collision_seen = latest.collision_seq;  // a new page starts from now
     }
-    std::fprintf(stderr, "web: client %llu (%s) connected\n", static_cast<unsigned long long>(p->id()),
-                 p->remote().c_str());
+    std::fprintf(stderr, "web: client %llu (%s) connected\n",
+                 static_cast<unsigned long long>(p->id()), p->remote().c_str());
     p->send(text(encode_hello("live", opt.gs.name)));
     on_tick(p);  // scene, status and task at once
   }
 
   void on_close(const std::shared_ptr<WebClient>& p) {
-    std::fprintf(stderr, "web: client %llu disconnected\n", static_cast<unsigned long long>(p->id()));
+    std::fprintf(stderr, "web: client %llu disconnected\n",
+                 static_cast<unsigned long long>(p->id()));
     clients.erase(p->id());
   }
 
-  void send_error(Client& c, const std::string& message, std::optional<std::int64_t> id = std::nullopt) {
+  void send_error(Client& c, const std::string& message,
+                  std::optional<std::int64_t> id = std::nullopt) {
     ++n.malformed;
     c.peer->send(text(encode_error(message, id)));
   }
@@ -239,7 +244,10 @@ struct WebBridge::Impl {
       }
       return;
     }
-    if (binary) return send_error(c, fmt::format("binary frame of {} bytes: only JSON text messages are accepted", t.size()));
+    if (binary)
+      return send_error(
+          c,
+          fmt::format("binary frame of {} bytes: only JSON text messages are accepted", t.size()));
     auto parsed = parse_client_message(t);
     if (!parsed.request) return send_error(c, parsed.error, parsed.id);
     std::visit([&](auto& r) { handle(c, r); }, *parsed.request);
@@ -252,15 +260,17 @@ struct WebBridge::Impl {
 
   void handle(Client& c, const CommandRequest& r) {
     if (c.rec) {
-      c.peer->send(text(encode_ack(r.id, to_string(r.kind), false,
-                                   "this page is playing a recording; go live to command the swarm")));
+      c.peer->send(
+          text(encode_ack(r.id, to_string(r.kind), false,
+                          "this page is playing a recording; go live to command the swarm")));
       return;
     }
     std::unique_lock<std::mutex> lock(jobs_mu);
     if (jobs.size() >= kMaxPendingCommands) {
       lock.unlock();
-      c.peer->send(text(encode_ack(r.id, to_string(r.kind), false,
-                                   fmt::format("busy: {} commands are waiting", kMaxPendingCommands))));
+      c.peer->send(
+          text(encode_ack(r.id, to_string(r.kind), false,
+                          fmt::format("busy: {} commands are waiting", kMaxPendingCommands))));
       return;
     }
     jobs.push_back({c.peer, r});
@@ -270,7 +280,9 @@ struct WebBridge::Impl {
   void handle(Client& c, const OpenRequest& r) {
     auto it = recordings.find(r.recording);
     if (it == recordings.end())
-      return send_error(c, fmt::format("open.recording = \"{}\": no such recording (upload it first)", r.recording));
+      return send_error(
+          c,
+          fmt::format("open.recording = \"{}\": no such recording (upload it first)", r.recording));
     c.rec = it->second;
     c.rt = c.rec->start();
     c.rate = 1;
@@ -297,7 +309,8 @@ struct WebBridge::Impl {
   }
 
   void handle(Client& c, const ReplayRequest& r) {
-    if (!c.rec) return send_error(c, "replay: this page is not playing a recording (open one first)");
+    if (!c.rec)
+      return send_error(c, "replay: this page is not playing a recording (open one first)");
     advance(c);
     const double end = c.rec->start() + c.rec->duration();
     switch (r.action) {
@@ -308,12 +321,16 @@ struct WebBridge::Impl {
         }
         c.playing = true;
         break;
-      case ReplayRequest::Action::kPause: c.playing = false; break;
+      case ReplayRequest::Action::kPause:
+        c.playing = false;
+        break;
       case ReplayRequest::Action::kSeek:
         c.rt = std::clamp(r.t_s, c.rec->start(), end);
         seek(c);
         break;
-      case ReplayRequest::Action::kRate: c.rate = r.rate; break;
+      case ReplayRequest::Action::kRate:
+        c.rate = r.rate;
+        break;
     }
     send_replay_info(c);
     on_tick(c.peer);
@@ -373,7 +390,8 @@ struct WebBridge::Impl {
       c.scene_sent = cache.scene_content;
       c.peer->send(cache.scene);
     }
-    if (cache.status && c.status_sent != cache.status_ver && now - c.status_wall >= kStatusPeriodS) {
+    if (cache.status && c.status_sent != cache.status_ver &&
+        now - c.status_wall >= kStatusPeriodS) {
       c.status_sent = cache.status_ver;
       c.status_wall = now;
       c.peer->send(cache.status);
@@ -460,7 +478,8 @@ struct WebBridge::Impl {
     const Recording& r = *c.rec;
     const double now = wall_seconds();
     while (c.status_idx < r.status.size() && r.status[c.status_idx].t <= c.rt) ++c.status_idx;
-    if (c.status_idx > 0 && c.status_sent_idx != c.status_idx && now - c.status_wall >= kStatusPeriodS) {
+    if (c.status_idx > 0 && c.status_sent_idx != c.status_idx &&
+        now - c.status_wall >= kStatusPeriodS) {
       c.status_sent_idx = c.status_idx;
       c.status_wall = now;
       c.peer->send(text(encode_status(r.status[c.status_idx - 1].sample)));
@@ -499,8 +518,8 @@ struct WebBridge::Impl {
         std::string why = e.what();  // name the upload, not our temporary file
         for (auto p = why.find(file.string()); p != std::string::npos; p = why.find(file.string()))
           why.replace(p, file.string().size(), name);
-        respond(400, nlohmann::json({{"error", why}}).dump(-1, ' ', false,
-                                                                              nlohmann::json::error_handler_t::replace));
+        respond(400, nlohmann::json({{"error", why}})
+                         .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
         return;
       }
       rec->id = id;
@@ -512,8 +531,8 @@ struct WebBridge::Impl {
           recordings.erase(recording_order.front());
           recording_order.pop_front();
         }
-        std::fprintf(stderr, "web: recording %s (%s): %zu frames, %.1f s\n", rec->id.c_str(), rec->name.c_str(),
-                     rec->frames.size(), rec->duration());
+        std::fprintf(stderr, "web: recording %s (%s): %zu frames, %.1f s\n", rec->id.c_str(),
+                     rec->name.c_str(), rec->frames.size(), rec->duration());
         respond(200, nlohmann::json({{"id", rec->id},
                                      {"name", rec->name},
                                      {"duration", rec->duration()},
@@ -549,18 +568,26 @@ struct WebBridge::Impl {
     try {
       if (!commander->wait_for_server(opt.gs.discovery_timeout_s))
         return {false, stop_requested() ? "stopping"
-                                        : fmt::format("no simulation server found on domain {}", opt.dds.domain_id)};
+                                        : fmt::format("no simulation server found on domain {}",
+                                                      opt.dds.domain_id)};
       switch (r.kind) {
-        case CommandKind::kTakeoff: return commander->takeoff(r.altitude_m);
-        case CommandKind::kMove: return commander->move(r.v, r.duration_s);
-        case CommandKind::kDistance: return commander->set_distance(r.value_m);
-        case CommandKind::kLand: return commander->land();
-        case CommandKind::kHold: return commander->hold();
+        case CommandKind::kTakeoff:
+          return commander->takeoff(r.altitude_m);
+        case CommandKind::kMove:
+          return commander->move(r.v, r.duration_s);
+        case CommandKind::kDistance:
+          return commander->set_distance(r.value_m);
+        case CommandKind::kLand:
+          return commander->land();
+        case CommandKind::kHold:
+          return commander->hold();
         case CommandKind::kTask:
           return commander->task(r.speed_mps > 0 ? r.speed_mps : opt.task.speed_mps,
                                  r.epsilon_m > 0 ? r.epsilon_m : opt.task.epsilon_m);
-        case CommandKind::kFollow: return commander->follow_leader(r.leader);
-        case CommandKind::kTeleop: return commander->teleop(r.v);
+        case CommandKind::kFollow:
+          return commander->follow_leader(r.leader);
+        case CommandKind::kTeleop:
+          return commander->teleop(r.v);
       }
       return {false, "unknown command"};
     } catch (const std::exception& e) {
@@ -582,7 +609,8 @@ WebBridgeCounts WebBridge::run() {
     return stop_requested() || impl_->stopping;
   });
   auto& n = impl_->n;
-  return {n.clients, n.frames_sent, n.frames_replaced, n.malformed, n.rate_limited, n.commands, n.uploads};
+  return {n.clients,      n.frames_sent, n.frames_replaced, n.malformed,
+          n.rate_limited, n.commands,    n.uploads};
 }
 
 }  // namespace ddswarm::gs::web

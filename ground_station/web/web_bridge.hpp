@@ -28,13 +28,14 @@ struct WebBridgeOptions {
 
 /// What the bridge did, for its closing line and the tests.
 struct WebBridgeCounts {
-  std::uint64_t clients = 0;          ///< WebSockets opened
-  std::uint64_t frames_sent = 0;      ///< frames handed to a client
-  std::uint64_t frames_replaced = 0;  ///< frames dropped because the client had not taken the previous one
-  std::uint64_t malformed = 0;        ///< client messages answered with `error`
-  std::uint64_t rate_limited = 0;     ///< client messages dropped over the rate limit
-  std::uint64_t commands = 0;         ///< commands run through DdsCommander
-  std::uint64_t uploads = 0;          ///< recordings indexed
+  std::uint64_t clients = 0;      ///< WebSockets opened
+  std::uint64_t frames_sent = 0;  ///< frames handed to a client
+  std::uint64_t frames_replaced =
+      0;  ///< frames dropped because the client had not taken the previous one
+  std::uint64_t malformed = 0;     ///< client messages answered with `error`
+  std::uint64_t rate_limited = 0;  ///< client messages dropped over the rate limit
+  std::uint64_t commands = 0;      ///< commands run through DdsCommander
+  std::uint64_t uploads = 0;       ///< recordings indexed
   std::string line() const;
 };
 

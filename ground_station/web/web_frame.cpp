@@ -1,7 +1,7 @@
 #include "ground_station/web/web_frame.hpp"
 
-#include <charconv>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -62,19 +62,26 @@ void put_array(std::string& out, const std::array<T, N>& a, int decimals) {
 
 const char* task_state(std::uint8_t phase) {
   switch (phase) {
-    case msg::TASK_NONE: return "none";
-    case msg::TASK_RUNNING: return "running";
-    case msg::TASK_COMPLETE: return "complete";
-    case msg::TASK_FAILED: return "failed";
+    case msg::TASK_NONE:
+      return "none";
+    case msg::TASK_RUNNING:
+      return "running";
+    case msg::TASK_COMPLETE:
+      return "complete";
+    case msg::TASK_FAILED:
+      return "failed";
   }
   return "unknown";
 }
 
 const char* contact_kind(std::uint8_t kind) {
   switch (kind) {
-    case msg::CONTACT_OBSTACLE: return "obstacle";
-    case msg::CONTACT_DRONE: return "drone";
-    case msg::CONTACT_GROUND: return "ground";
+    case msg::CONTACT_OBSTACLE:
+      return "obstacle";
+    case msg::CONTACT_DRONE:
+      return "drone";
+    case msg::CONTACT_GROUND:
+      return "ground";
   }
   return "unknown";
 }
@@ -109,7 +116,8 @@ Frame to_frame(const msg::SwarmState& s) {
   for (const auto& sc : s.scans()) {
     if (sc.drone_id() >= f.drones.size()) continue;
     auto& o = f.drones[sc.drone_id()];
-    const std::size_t n = std::min({sc.angle_body_rad().size(), sc.range_m().size(), sc.hit().size()});
+    const std::size_t n =
+        std::min({sc.angle_body_rad().size(), sc.range_m().size(), sc.hit().size()});
     o.ray_angle.assign(sc.angle_body_rad().begin(), sc.angle_body_rad().begin() + n);
     o.ray_range.assign(sc.range_m().begin(), sc.range_m().begin() + n);
     o.ray_hit.assign(sc.hit().begin(), sc.hit().begin() + n);
@@ -200,15 +208,18 @@ std::string encode_frame(const Frame& f, bool rays) {
 }
 
 std::string encode_hello(std::string_view source, std::string_view gs_name) {
-  return dump({{"type", "hello"}, {"version", kProtocolVersion}, {"source", source}, {"gs_name", gs_name}});
+  return dump(
+      {{"type", "hello"}, {"version", kProtocolVersion}, {"source", source}, {"gs_name", gs_name}});
 }
 
 std::string encode_scene(const msg::Scene& s) {
   const SceneConfig world = from_msg(s);
   json cyl = json::array(), box = json::array();
   for (const auto& c : world.cylinders)
-    cyl.push_back({{"x", c.center_xy.x()}, {"y", c.center_xy.y()}, {"r", c.radius_m}, {"h", c.height_m}});
-  for (const auto& b : world.boxes) box.push_back({{"c", vec(b.center)}, {"s", vec(b.size)}, {"yaw", b.yaw_rad}});
+    cyl.push_back(
+        {{"x", c.center_xy.x()}, {"y", c.center_xy.y()}, {"r", c.radius_m}, {"h", c.height_m}});
+  for (const auto& b : world.boxes)
+    box.push_back({{"c", vec(b.center)}, {"s", vec(b.size)}, {"yaw", b.yaw_rad}});
   return dump({{"type", "scene"},
                {"name", s.name().to_string()},
                {"seed", s.seed()},
@@ -230,38 +241,41 @@ std::string encode_scene(const msg::Scene& s) {
 
 std::string encode_status(const msg::SimStatus& s) {
   const std::uint64_t rejected = std::uint64_t{s.rejected_non_finite()} + s.rejected_absurd() +
-                                 s.rejected_unknown_id() + s.rejected_stale_tick() + s.rejected_future_tick() +
-                                 s.rejected_impostor() + s.rejected_mission();
-  return dump({{"type", "status"},
-               {"tick", s.tick()},
-               {"t", s.sim_time_s()},
-               {"rtf", s.real_time_factor()},
-               {"state", s.state().to_string()},
-               {"mode", s.mode() == msg::MODE_LOCKSTEP ? "lockstep" : "realtime"},
-               {"num_drones", s.num_drones()},
-               {"agents_live", s.agents_live()},
-               {"live", s.live_agents()},
-               {"airborne", s.airborne()},
-               {"failsafe", s.failsafe()},
-               {"collisions", {s.collisions_obstacle(), s.collisions_drone(), s.collisions_ground()}},
-               {"rejected", rejected}});
+                                 s.rejected_unknown_id() + s.rejected_stale_tick() +
+                                 s.rejected_future_tick() + s.rejected_impostor() +
+                                 s.rejected_mission();
+  return dump(
+      {{"type", "status"},
+       {"tick", s.tick()},
+       {"t", s.sim_time_s()},
+       {"rtf", s.real_time_factor()},
+       {"state", s.state().to_string()},
+       {"mode", s.mode() == msg::MODE_LOCKSTEP ? "lockstep" : "realtime"},
+       {"num_drones", s.num_drones()},
+       {"agents_live", s.agents_live()},
+       {"live", s.live_agents()},
+       {"airborne", s.airborne()},
+       {"failsafe", s.failsafe()},
+       {"collisions", {s.collisions_obstacle(), s.collisions_drone(), s.collisions_ground()}},
+       {"rejected", rejected}});
 }
 
 std::string encode_task(const msg::TaskStatus& t) {
   const char* state = task_state(t.phase());
-  return dump({{"type", "task"},
-               {"state", state},
-               {"phase", state},
-               {"elapsed", t.elapsed_s()},
-               {"reason", t.reason().to_string()},
-               {"speed", t.speed_mps()},
-               {"epsilon", t.epsilon_m()},
-               {"drones", t.drones()},
-               {"past_finish", t.past_finish()},
-               {"max_pair", t.max_pair_distance_m()},
-               {"min_inter_drone", t.min_inter_drone_m()},
-               {"min_clearance", t.min_clearance_m()},
-               {"collisions", {t.collisions_obstacle(), t.collisions_drone(), t.collisions_ground()}}});
+  return dump(
+      {{"type", "task"},
+       {"state", state},
+       {"phase", state},
+       {"elapsed", t.elapsed_s()},
+       {"reason", t.reason().to_string()},
+       {"speed", t.speed_mps()},
+       {"epsilon", t.epsilon_m()},
+       {"drones", t.drones()},
+       {"past_finish", t.past_finish()},
+       {"max_pair", t.max_pair_distance_m()},
+       {"min_inter_drone", t.min_inter_drone_m()},
+       {"min_clearance", t.min_clearance_m()},
+       {"collisions", {t.collisions_obstacle(), t.collisions_drone(), t.collisions_ground()}}});
 }
 
 std::string encode_collision(const msg::CollisionEvent& e, std::uint64_t dropped) {
@@ -298,14 +312,22 @@ std::string encode_replay(const ReplayInfo& r) {
 
 const char* to_string(CommandKind k) {
   switch (k) {
-    case CommandKind::kTakeoff: return "takeoff";
-    case CommandKind::kMove: return "move";
-    case CommandKind::kDistance: return "distance";
-    case CommandKind::kLand: return "land";
-    case CommandKind::kHold: return "hold";
-    case CommandKind::kTask: return "task";
-    case CommandKind::kFollow: return "follow";
-    case CommandKind::kTeleop: return "teleop";
+    case CommandKind::kTakeoff:
+      return "takeoff";
+    case CommandKind::kMove:
+      return "move";
+    case CommandKind::kDistance:
+      return "distance";
+    case CommandKind::kLand:
+      return "land";
+    case CommandKind::kHold:
+      return "hold";
+    case CommandKind::kTask:
+      return "task";
+    case CommandKind::kFollow:
+      return "follow";
+    case CommandKind::kTeleop:
+      return "teleop";
   }
   return "unknown";
 }
@@ -320,7 +342,8 @@ struct Bad {
 
 /// A value as the error names it: short JSON, "inf"/"nan" for what JSON cannot say.
 std::string show(const json& v) {
-  if (v.is_number_float() && !std::isfinite(v.get<double>())) return std::isnan(v.get<double>()) ? "nan" : "inf";
+  if (v.is_number_float() && !std::isfinite(v.get<double>()))
+    return std::isnan(v.get<double>()) ? "nan" : "inf";
   std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
   if (s.size() > 40) s = s.substr(0, 37) + "...";
   return s;
@@ -367,16 +390,19 @@ class Fields {
     if (!v->is_string()) throw Bad{name(key) + " = " + show(*v) + ": must be a string"};
     auto s = v->get<std::string>();
     if (s.empty() || s.size() > max_len)
-      throw Bad{name(key) + " = " + show(*v) + ": must be 1 to " + std::to_string(max_len) + " characters"};
+      throw Bad{name(key) + " = " + show(*v) + ": must be 1 to " + std::to_string(max_len) +
+                " characters"};
     return s;
   }
 
   Eigen::Vector3d vec3(const char* key, double lo, double hi) {
     const json* v = find(key);
     if (!v) throw Bad{name(key) + ": missing"};
-    if (!v->is_array() || v->size() != 3) throw Bad{name(key) + " = " + show(*v) + ": must be [x, y, z]"};
+    if (!v->is_array() || v->size() != 3)
+      throw Bad{name(key) + " = " + show(*v) + ": must be [x, y, z]"};
     Eigen::Vector3d out;
-    for (int i = 0; i < 3; ++i) out[i] = check_number((*v)[i], name(key) + "[" + std::to_string(i) + "]", lo, hi);
+    for (int i = 0; i < 3; ++i)
+      out[i] = check_number((*v)[i], name(key) + "[" + std::to_string(i) + "]", lo, hi);
     return out;
   }
 
@@ -390,7 +416,9 @@ class Fields {
     }
   }
 
-  std::string name(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  std::string name(const std::string& key) const {
+    return prefix_.empty() ? key : prefix_ + "." + key;
+  }
 
  private:
   static double check_number(const json& v, const std::string& what, double lo, double hi) {
@@ -485,7 +513,8 @@ ClientRequest parse_object(const json& j, std::optional<std::int64_t>& id_out) {
       r.action = ReplayRequest::Action::kRate;
       r.rate = f.number("rate", 0.1, 16, std::nullopt);
     } else {
-      throw Bad{"replay.action = " + show(json(action)) + ": unknown (expected play, pause, seek, rate)"};
+      throw Bad{"replay.action = " + show(json(action)) +
+                ": unknown (expected play, pause, seek, rate)"};
     }
     out = r;
   } else {
@@ -512,9 +541,12 @@ ParsedMessage parse_client_message(std::string_view text) {
     bool in_string = false, escaped = false;
     for (char c : text) {
       if (in_string) {
-        if (escaped) escaped = false;
-        else if (c == '\\') escaped = true;
-        else if (c == '"') in_string = false;
+        if (escaped)
+          escaped = false;
+        else if (c == '\\')
+          escaped = true;
+        else if (c == '"')
+          in_string = false;
       } else if (c == '"') {
         in_string = true;
       } else if (c == '[' || c == '{') {

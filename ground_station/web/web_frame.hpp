@@ -28,22 +28,22 @@ constexpr int kMaxClientNesting = 8;  ///< arrays/objects inside each other; the
 /// One drone as the page draws it.
 struct DroneFrame {
   int id = 0;
-  std::array<float, 3> p{};       ///< m, world ENU, body centre
+  std::array<float, 3> p{};            ///< m, world ENU, body centre
   std::array<float, 4> q{1, 0, 0, 0};  ///< body to world, [w, x, y, z]
-  std::array<float, 3> v{};       ///< m/s, world
-  std::array<float, 4> w{};       ///< rad/s, rotor speeds
-  std::uint16_t flags = 0;        ///< DroneState.flags bits
-  std::uint8_t phase = 0;         ///< common/mission.hpp Phase
+  std::array<float, 3> v{};            ///< m/s, world
+  std::array<float, 4> w{};            ///< rad/s, rotor speeds
+  std::uint16_t flags = 0;             ///< DroneState.flags bits
+  std::uint8_t phase = 0;              ///< common/mission.hpp Phase
   std::array<std::uint32_t, 3> col{};  ///< contacts begun: obstacle, drone, ground
-  std::vector<float> ray_angle;   ///< rad, body yaw of each ray (empty: no scan)
-  std::vector<float> ray_range;   ///< m, measured range
-  std::vector<std::uint8_t> ray_hit;  ///< 1 if something is within range
+  std::vector<float> ray_angle;        ///< rad, body yaw of each ray (empty: no scan)
+  std::vector<float> ray_range;        ///< m, measured range
+  std::vector<std::uint8_t> ray_hit;   ///< 1 if something is within range
 };
 
 /// The swarm at one tick.
 struct Frame {
   std::uint64_t tick = 0;
-  double t = 0;  ///< s, sim time
+  double t = 0;                    ///< s, sim time
   std::vector<DroneFrame> drones;  ///< index = drone id
 };
 
@@ -90,15 +90,15 @@ const char* to_string(CommandKind k);
 
 /// A mission command, checked against the CLI's ranges.
 struct CommandRequest {
-  std::int64_t id = 0;       ///< the client's, echoed in the ack
+  std::int64_t id = 0;  ///< the client's, echoed in the ack
   CommandKind kind = CommandKind::kHold;
-  double altitude_m = 0;     ///< takeoff; 0 = agents' default
+  double altitude_m = 0;       ///< takeoff; 0 = agents' default
   Eigen::Vector3d v{0, 0, 0};  ///< m/s ENU (move, teleop)
-  double duration_s = 0;     ///< move
-  double value_m = 0;        ///< distance: new D_int
-  double speed_mps = 0;      ///< task; 0 = scenario default
-  double epsilon_m = 0;      ///< task; 0 = scenario default
-  int leader = 0;            ///< follow
+  double duration_s = 0;       ///< move
+  double value_m = 0;          ///< distance: new D_int
+  double speed_mps = 0;        ///< task; 0 = scenario default
+  double epsilon_m = 0;        ///< task; 0 = scenario default
+  int leader = 0;              ///< follow
 };
 
 struct OpenRequest {
@@ -111,7 +111,8 @@ struct ReplayRequest {
   double rate = 1;  ///< rate: [0.1, 16]
 };
 
-using ClientRequest = std::variant<SubscribeRequest, CommandRequest, OpenRequest, LiveRequest, ReplayRequest>;
+using ClientRequest =
+    std::variant<SubscribeRequest, CommandRequest, OpenRequest, LiveRequest, ReplayRequest>;
 
 /// A parsed client message: request set, or error (one line naming the field and value).
 struct ParsedMessage {

@@ -160,8 +160,8 @@ TEST(WebFrame, SceneStatusTaskCollisionAckFields) {
   EXPECT_EQ(j["cylinders"][0], json({{"x", 1}, {"y", 2}, {"r", 0.3}, {"h", 5}}));
   EXPECT_EQ(j["boxes"][0]["yaw"], 0.5);
   EXPECT_EQ(j["boxes"][0]["c"].size(), 3u);
-  for (auto k : {"ground_z", "bounds_min", "bounds_max", "finish_a", "finish_b", "goal", "drone_radius",
-                 "arm_length", "sensor_count", "sensor_range", "seed", "name"})
+  for (auto k : {"ground_z", "bounds_min", "bounds_max", "finish_a", "finish_b", "goal",
+                 "drone_radius", "arm_length", "sensor_count", "sensor_range", "seed", "name"})
     EXPECT_TRUE(j.contains(k)) << k;
 
   msg::SimStatus st;
@@ -201,7 +201,10 @@ TEST(WebFrame, SceneStatusTaskCollisionAckFields) {
   EXPECT_EQ(j["dropped"], 5);
 
   j = json::parse(encode_ack(12, "takeoff", true, "takeoff 6/6 acknowledged"));
-  EXPECT_EQ(j, json({{"type", "ack"}, {"id", 12}, {"cmd", "takeoff"}, {"ok", true},
+  EXPECT_EQ(j, json({{"type", "ack"},
+                     {"id", 12},
+                     {"cmd", "takeoff"},
+                     {"ok", true},
                      {"message", "takeoff 6/6 acknowledged"}}));
   j = json::parse(encode_hello("live", "gs"));
   EXPECT_EQ(j["version"], 1);
@@ -229,7 +232,8 @@ TEST(WebParse, ValidMessages) {
   EXPECT_EQ(s.fps, 20);
   EXPECT_TRUE(s.rays);
 
-  p = parse_client_message(R"({"type":"command","id":7,"cmd":"move","v":[1,-2,0.5],"duration":30})");
+  p = parse_client_message(
+      R"({"type":"command","id":7,"cmd":"move","v":[1,-2,0.5],"duration":30})");
   ASSERT_TRUE(p.request) << p.error;
   auto c = std::get<CommandRequest>(*p.request);
   EXPECT_EQ(c.id, 7);
@@ -240,21 +244,25 @@ TEST(WebParse, ValidMessages) {
   p = parse_client_message(R"({"type":"command","id":1,"cmd":"takeoff"})");
   ASSERT_TRUE(p.request) << p.error;
   EXPECT_EQ(std::get<CommandRequest>(*p.request).altitude_m, 0);
-  for (auto text : {R"({"type":"command","id":2,"cmd":"land"})", R"({"type":"command","id":2,"cmd":"hold"})",
-                    R"({"type":"command","id":2,"cmd":"task","speed":0.8})",
-                    R"({"type":"command","id":2,"cmd":"distance","value":6})",
-                    R"({"type":"command","id":2,"cmd":"follow","leader":0})",
-                    R"({"type":"command","id":2,"cmd":"teleop","v":[0,1,0]})", R"({"type":"live"})",
-                    R"({"type":"open","recording":"r1"})", R"({"type":"replay","action":"seek","t":3.5})",
-                    R"({"type":"replay","action":"rate","rate":4})", R"({"type":"replay","action":"pause"})"}) {
-    EXPECT_TRUE(parse_client_message(text).request) << text << ": " << parse_client_message(text).error;
+  for (auto text :
+       {R"({"type":"command","id":2,"cmd":"land"})", R"({"type":"command","id":2,"cmd":"hold"})",
+        R"({"type":"command","id":2,"cmd":"task","speed":0.8})",
+        R"({"type":"command","id":2,"cmd":"distance","value":6})",
+        R"({"type":"command","id":2,"cmd":"follow","leader":0})",
+        R"({"type":"command","id":2,"cmd":"teleop","v":[0,1,0]})", R"({"type":"live"})",
+        R"({"type":"open","recording":"r1"})", R"({"type":"replay","action":"seek","t":3.5})",
+        R"({"type":"replay","action":"rate","rate":4})", R"({"type":"replay","action":"pause"})"}) {
+    EXPECT_TRUE(parse_client_message(text).request)
+        << text << ": " << parse_client_message(text).error;
   }
 }
 
 TEST(WebParse, NotJson) {
   EXPECT_EQ(error_of("takeoff now").rfind("not JSON", 0), 0u);
   EXPECT_EQ(error_of("").rfind("not JSON", 0), 0u);
-  EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"takeoff","altitude":NaN})").rfind("not JSON", 0), 0u);
+  EXPECT_EQ(
+      error_of(R"({"type":"command","id":1,"cmd":"takeoff","altitude":NaN})").rfind("not JSON", 0),
+      0u);
   EXPECT_EQ(error_of(R"({"type":"subscribe")").rfind("not JSON", 0), 0u);
   EXPECT_EQ(error_of("\xff\xfe").rfind("not JSON", 0), 0u);
   EXPECT_EQ(error_of("[1,2]"), "message = [1,2]: must be a JSON object with a type");
@@ -265,8 +273,12 @@ TEST(WebParse, UnknownTypeAndCommand) {
   EXPECT_EQ(error_of(R"({"type":5})"), "type = 5: must be a string");
   EXPECT_EQ(error_of(R"({"type":"explode"})"),
             R"(type = "explode": unknown (expected subscribe, command, open, live, replay))");
-  EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"selfdestruct"})").rfind(R"(command.cmd = "selfdestruct": unknown)", 0), 0u);
-  EXPECT_EQ(error_of(R"({"type":"replay","action":"rewind"})").rfind(R"(replay.action = "rewind": unknown)", 0), 0u);
+  EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"selfdestruct"})")
+                .rfind(R"(command.cmd = "selfdestruct": unknown)", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"type":"replay","action":"rewind"})")
+                .rfind(R"(replay.action = "rewind": unknown)", 0),
+            0u);
 }
 
 TEST(WebParse, NonFiniteAndWrongTypes) {
@@ -279,15 +291,18 @@ TEST(WebParse, NonFiniteAndWrongTypes) {
             "command.v[1] = null: must be a number");
   EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"move","v":[1,0],"duration":3})"),
             "command.v = [1,0]: must be [x, y, z]");
-  EXPECT_EQ(error_of(R"({"type":"subscribe","rays":"yes"})"), R"(subscribe.rays = "yes": must be true or false)");
-  EXPECT_EQ(error_of(R"({"type":"command","id":1.5,"cmd":"land"})"), "command.id = 1.5: must be an integer");
+  EXPECT_EQ(error_of(R"({"type":"subscribe","rays":"yes"})"),
+            R"(subscribe.rays = "yes": must be true or false)");
+  EXPECT_EQ(error_of(R"({"type":"command","id":1.5,"cmd":"land"})"),
+            "command.id = 1.5: must be an integer");
   EXPECT_EQ(error_of(R"({"type":"open","recording":7})"), "open.recording = 7: must be a string");
 }
 
 TEST(WebParse, MissingAndOutOfRange) {
   EXPECT_EQ(error_of(R"({"type":"command","cmd":"land"})"), "command.id: missing");
   EXPECT_EQ(error_of(R"({"type":"command","id":1})"), "command.cmd: missing");
-  EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"move","v":[1,0,0]})"), "command.duration: missing");
+  EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"move","v":[1,0,0]})"),
+            "command.duration: missing");
   EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"distance","value":0.1})"),
             "command.value = 0.1: must be in [0.31, 1000]");
   EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"move","v":[51,0,0],"duration":1})"),
@@ -295,15 +310,20 @@ TEST(WebParse, MissingAndOutOfRange) {
   EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"takeoff","altitude":-1})"),
             "command.altitude = -1: must be in [0, 1000]");
   EXPECT_EQ(error_of(R"({"type":"subscribe","fps":0})"), "subscribe.fps = 0: must be in [1, 60]");
-  EXPECT_EQ(error_of(R"({"type":"subscribe","fps":1000})"), "subscribe.fps = 1000: must be in [1, 60]");
-  EXPECT_EQ(error_of(R"({"type":"replay","action":"rate","rate":100})"), "replay.rate = 100: must be in [0.1, 16]");
-  EXPECT_EQ(error_of(R"({"type":"command","id":-1,"cmd":"land"})").rfind("command.id = -1: must be in [0,", 0), 0u);
+  EXPECT_EQ(error_of(R"({"type":"subscribe","fps":1000})"),
+            "subscribe.fps = 1000: must be in [1, 60]");
+  EXPECT_EQ(error_of(R"({"type":"replay","action":"rate","rate":100})"),
+            "replay.rate = 100: must be in [0.1, 16]");
+  EXPECT_EQ(error_of(R"({"type":"command","id":-1,"cmd":"land"})")
+                .rfind("command.id = -1: must be in [0,", 0),
+            0u);
   EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"follow","leader":2000})"),
             "command.leader = 2000: must be in [0, 1023]");
 }
 
 TEST(WebParse, UnknownFieldsAreNamed) {
-  EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"takeoff","altitute":3})"), "command.altitute: unknown field");
+  EXPECT_EQ(error_of(R"({"type":"command","id":1,"cmd":"takeoff","altitute":3})"),
+            "command.altitute: unknown field");
   EXPECT_EQ(error_of(R"({"type":"live","now":true})"), "live.now: unknown field");
 }
 
@@ -317,9 +337,12 @@ TEST(WebParse, CommandErrorsCarryTheIdWhenReadable) {
 
 TEST(WebParse, HugeAndDeeplyNestedMessages) {
   std::string big = R"({"type":"live","x":")" + std::string(kMaxClientMessageBytes, 'a') + "\"}";
-  EXPECT_EQ(error_of(big), "message of " + std::to_string(big.size()) + " bytes: over the 64 KiB limit");
-  std::string deep = std::string(30000, '[') + std::string(30000, ']');  // under the limit, must not overflow the stack
+  EXPECT_EQ(error_of(big),
+            "message of " + std::to_string(big.size()) + " bytes: over the 64 KiB limit");
+  std::string deep = std::string(30000, '[') +
+                     std::string(30000, ']');  // under the limit, must not overflow the stack
   EXPECT_EQ(error_of(deep), "message nested 30000 deep: over the limit of 8");
   // Brackets inside strings are text, not nesting.
-  EXPECT_EQ(error_of(R"({"type":"live","x":"[[[[[[[[[[[[[[[[[["})").rfind("message nested", 0), std::string::npos);
+  EXPECT_EQ(error_of(R"({"type":"live","x":"[[[[[[[[[[[[[[[[[["})").rfind("message nested", 0),
+            std::string::npos);
 }

@@ -37,7 +37,8 @@ enum class Kind { kNone, kState, kScene, kStatus, kTask, kCollision };
 }  // namespace
 
 std::size_t Recording::frame_at(double t) const {
-  auto it = std::upper_bound(frames.begin(), frames.end(), t, [](double x, const Frame& f) { return x < f.t; });
+  auto it = std::upper_bound(frames.begin(), frames.end(), t,
+                             [](double x, const Frame& f) { return x < f.t; });
   return it == frames.begin() ? 0 : static_cast<std::size_t>(it - frames.begin()) - 1;
 }
 
@@ -71,7 +72,8 @@ std::shared_ptr<Recording> load_recording(const std::string& path, const std::st
     auto it = kind.find(m.channel_id);
     if (it == kind.end()) return;
     switch (it->second) {
-      case Kind::kNone: return;
+      case Kind::kNone:
+        return;
       case Kind::kState: {
         if (!from_cdr(m.data, state)) {
           ++undecodable;
@@ -91,7 +93,8 @@ std::shared_ptr<Recording> load_recording(const std::string& path, const std::st
         f.t = now;
         bytes += frame_bytes(f);
         rec->frames.push_back(std::move(f));
-        while (bytes > limits.max_bytes && rec->frames.size() > 1) {  // halve the rate, keep every other frame
+        while (bytes > limits.max_bytes &&
+               rec->frames.size() > 1) {  // halve the rate, keep every other frame
           std::vector<Frame> kept;
           bytes = 0;
           for (std::size_t i = 0; i < rec->frames.size(); i += 2) {
@@ -127,8 +130,9 @@ std::shared_ptr<Recording> load_recording(const std::string& path, const std::st
     }
   });
   if (rec->frames.empty())
-    throw std::runtime_error(undecodable ? "its swarm state samples cannot be decoded"
-                                         : "it holds no swarm state (record the ddswarm/swarm_state topic)");
+    throw std::runtime_error(
+        undecodable ? "its swarm state samples cannot be decoded"
+                    : "it holds no swarm state (record the ddswarm/swarm_state topic)");
   // Samples before the first frame belong at its time.
   const double t0 = rec->frames.front().t;
   for (auto& s : rec->status)

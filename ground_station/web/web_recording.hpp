@@ -19,15 +19,16 @@ struct Timed {
 };
 
 struct Recording {
-  std::string id;    ///< what `open` names
-  std::string name;  ///< the uploaded file's name
+  std::string id;             ///< what `open` names
+  std::string name;           ///< the uploaded file's name
   std::vector<Frame> frames;  ///< ordered by t (Frame::t is the timeline time)
   std::optional<msg::Scene> scene;
   std::vector<Timed<msg::SimStatus>> status;
   std::vector<Timed<msg::TaskStatus>> tasks;
   std::vector<Timed<msg::CollisionEvent>> collisions;
-  std::uint64_t messages = 0;       ///< messages in the file
-  std::uint64_t frames_skipped = 0; ///< SwarmState samples left out to stay within the memory bound
+  std::uint64_t messages = 0;  ///< messages in the file
+  std::uint64_t frames_skipped =
+      0;  ///< SwarmState samples left out to stay within the memory bound
   double start() const { return frames.empty() ? 0 : frames.front().t; }
   double duration() const { return frames.empty() ? 0 : frames.back().t - frames.front().t; }
   /// Index of the last frame at or before t (0 if t is before the first).
@@ -35,7 +36,7 @@ struct Recording {
 };
 
 struct RecordingLimits {
-  double max_frame_rate_hz = 60;          ///< frames kept per sim second at most
+  double max_frame_rate_hz = 60;           ///< frames kept per sim second at most
   std::uint64_t max_bytes = 256ull << 20;  ///< memory for frames; the rate is halved until they fit
 };
 

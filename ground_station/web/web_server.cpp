@@ -3,8 +3,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <utility>  // before Boost 1.74's asio: its awaitable.hpp uses std::exchange
+
+#include <atomic>
 #include <boost/asio.hpp>
 #include <boost/beast.hpp>
 #include <deque>
@@ -116,17 +117,21 @@ void WebServerConfig::validate() const {
   check_range("--web port", port, 0, 65535);
   if (!a.is_loopback() && !allow_remote)
     throw FieldError("--web", address,
-                     "not a loopback address; the page can command the swarm, add --web-allow-remote to serve other hosts");
-  if (max_upload_bytes < (1u << 20)) throw FieldError("--web-max-upload-mb", std::to_string(max_upload_bytes >> 20), "must be >= 1");
+                     "not a loopback address; the page can command the swarm, add "
+                     "--web-allow-remote to serve other hosts");
+  if (max_upload_bytes < (1u << 20))
+    throw FieldError("--web-max-upload-mb", std::to_string(max_upload_bytes >> 20), "must be >= 1");
   std::error_code fec;
-  if (!std::filesystem::is_directory(web_root, fec)) throw FieldError("--web-root", web_root.string(), "not a directory");
+  if (!std::filesystem::is_directory(web_root, fec))
+    throw FieldError("--web-root", web_root.string(), "not a directory");
 }
 
 void parse_listen_address(const std::string& text, WebServerConfig& c) {
   std::string addr, port;
   if (!text.empty() && text[0] == '[') {
     auto close = text.find("]:");
-    if (close == std::string::npos) throw FieldError("--web", text, "expected ADDR:PORT, e.g. 127.0.0.1:8080");
+    if (close == std::string::npos)
+      throw FieldError("--web", text, "expected ADDR:PORT, e.g. 127.0.0.1:8080");
     addr = text.substr(1, close - 1);
     port = text.substr(close + 2);
   } else {
@@ -136,8 +141,8 @@ void parse_listen_address(const std::string& text, WebServerConfig& c) {
     addr = text.substr(0, colon);
     port = text.substr(colon + 1);
   }
-  if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos ||
-      std::stoi(port) > 65535)
+  if (port.empty() || port.size() > 5 ||
+      port.find_first_not_of("0123456789") != std::string::npos || std::stoi(port) > 65535)
     throw FieldError("--web", text, "port must be a number in [0, 65535]");
   beast::error_code ec;
   asio::ip::make_address(addr, ec);
@@ -148,11 +153,13 @@ void parse_listen_address(const std::string& text, WebServerConfig& c) {
 
 std::filesystem::path default_web_root() { return DDSWARM_WEB_ROOT; }
 
-std::optional<std::filesystem::path> resolve_static_path(const std::filesystem::path& root, std::string_view target) {
+std::optional<std::filesystem::path> resolve_static_path(const std::filesystem::path& root,
+                                                         std::string_view target) {
   namespace fs = std::filesystem;
   auto path = percent_decode(path_of(target));
   if (!path || path->empty() || (*path)[0] != '/') return std::nullopt;
-  if (path->find('\0') != std::string::npos || path->find('\\') != std::string::npos) return std::nullopt;
+  if (path->find('\0') != std::string::npos || path->find('\\') != std::string::npos)
+    return std::nullopt;
   std::vector<std::string> seg;
   std::size_t i = 1;
   while (i <= path->size()) {
@@ -185,17 +192,28 @@ std::optional<std::filesystem::path> resolve_static_path(const std::filesystem::
 
 std::string mime_type(const std::filesystem::path& file) {
   static const std::map<std::string, std::string> types = {
-      {".html", "text/html; charset=utf-8"},   {".htm", "text/html; charset=utf-8"},
-      {".js", "text/javascript; charset=utf-8"}, {".mjs", "text/javascript; charset=utf-8"},
-      {".css", "text/css; charset=utf-8"},     {".json", "application/json"},
-      {".map", "application/json"},            {".svg", "image/svg+xml"},
-      {".png", "image/png"},                   {".jpg", "image/jpeg"},
-      {".jpeg", "image/jpeg"},                 {".gif", "image/gif"},
-      {".ico", "image/x-icon"},                {".webp", "image/webp"},
-      {".wasm", "application/wasm"},           {".txt", "text/plain; charset=utf-8"},
-      {".md", "text/plain; charset=utf-8"},    {".glb", "model/gltf-binary"},
-      {".gltf", "model/gltf+json"},            {".woff2", "font/woff2"},
-      {".ktx2", "image/ktx2"},                 {".hdr", "application/octet-stream"},
+      {".html", "text/html; charset=utf-8"},
+      {".htm", "text/html; charset=utf-8"},
+      {".js", "text/javascript; charset=utf-8"},
+      {".mjs", "text/javascript; charset=utf-8"},
+      {".css", "text/css; charset=utf-8"},
+      {".json", "application/json"},
+      {".map", "application/json"},
+      {".svg", "image/svg+xml"},
+      {".png", "image/png"},
+      {".jpg", "image/jpeg"},
+      {".jpeg", "image/jpeg"},
+      {".gif", "image/gif"},
+      {".ico", "image/x-icon"},
+      {".webp", "image/webp"},
+      {".wasm", "application/wasm"},
+      {".txt", "text/plain; charset=utf-8"},
+      {".md", "text/plain; charset=utf-8"},
+      {".glb", "model/gltf-binary"},
+      {".gltf", "model/gltf+json"},
+      {".woff2", "font/woff2"},
+      {".ktx2", "image/ktx2"},
+      {".hdr", "application/octet-stream"},
   };
   auto it = types.find(lower(file.extension().string()));
   return it == types.end() ? "application/octet-stream" : it->second;
@@ -230,9 +248,9 @@ struct ServerCore {
   int uploads = 0;
   bool stopping = false;
   struct {
-    std::atomic<std::uint64_t> http_requests{0}, http_errors{0}, ws_opened{0}, ws_closed{0}, too_big{0};
+    std::atomic<std::uint64_t> http_requests{0}, http_errors{0}, ws_opened{0}, ws_closed{0},
+        too_big{0};
   } n;
-
 };
 
 struct WebServer::Impl : ServerCore {
@@ -318,7 +336,8 @@ class WsSession final : public WebClient, public std::enable_shared_from_this<Ws
       if (self->finished_) return;
       const auto data = self->buf_.cdata();
       std::string_view text(static_cast<const char*>(data.data()), data.size());
-      if (self->srv_.hooks.on_message) self->srv_.hooks.on_message(self, text, !self->ws_.got_text());
+      if (self->srv_.hooks.on_message)
+        self->srv_.hooks.on_message(self, text, !self->ws_.got_text());
       self->buf_.consume(self->buf_.size());
       self->read();
     });
@@ -337,12 +356,13 @@ class WsSession final : public WebClient, public std::enable_shared_from_this<Ws
       return;
     }
     writing_ = true;
-    ws_.async_write(asio::buffer(*current_), [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      self->writing_ = false;
-      self->current_.reset();
-      if (ec) return self->finish();
-      self->write();
-    });
+    ws_.async_write(asio::buffer(*current_),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                      self->writing_ = false;
+                      self->current_.reset();
+                      if (ec) return self->finish();
+                      self->write();
+                    });
   }
 
   void start_close() {
@@ -373,7 +393,8 @@ class WsSession final : public WebClient, public std::enable_shared_from_this<Ws
   std::string remote_;
   std::deque<std::shared_ptr<const std::string>> queue_;
   std::shared_ptr<const std::string> frame_, current_;
-  bool writing_ = false, closing_ = false, close_started_ = false, finished_ = false, opened_ = false;
+  bool writing_ = false, closing_ = false, close_started_ = false, finished_ = false,
+       opened_ = false;
 };
 
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
@@ -387,11 +408,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     // reads Content-Length: let uploads through to our --web-max-upload-mb check.
     header_->body_limit(srv_.cfg.max_upload_bytes);
     stream_.expires_after(kHttpTimeout);
-    http::async_read_header(stream_, buf_, *header_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) return self->close();
-      self->srv_.n.http_requests++;
-      self->route();
-    });
+    http::async_read_header(stream_, buf_, *header_,
+                            [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                              if (ec) return self->close();
+                              self->srv_.n.http_requests++;
+                              self->route();
+                            });
   }
 
  private:
@@ -405,19 +427,22 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     api_ = path.rfind("/api/", 0) == 0;
     const std::string origin(req[http::field::origin]);
     const std::string host(req[http::field::host]);
-    const bool trusted = same_origin(origin, host) && (srv_.cfg.allow_remote || loopback_host(host));
+    const bool trusted =
+        same_origin(origin, host) && (srv_.cfg.allow_remote || loopback_host(host));
 
     if (websocket::is_upgrade(req)) {
       if (path != "/ws") return error(http::status::not_found, "no WebSocket here; use /ws");
       if (!trusted) return error(http::status::forbidden, "cross-origin WebSocket refused");
-      if (srv_.clients.size() >= kMaxClients) return error(http::status::service_unavailable, "too many clients");
+      if (srv_.clients.size() >= kMaxClients)
+        return error(http::status::service_unavailable, "too many clients");
       if (srv_.stopping) return error(http::status::service_unavailable, "shutting down");
       auto ws = std::make_shared<WsSession>(srv_, stream_.release_socket(), srv_.next_id++);
       ws->start(header_->release());
       return;
     }
     if (path == "/api/recording") {
-      if (req.method() != http::verb::post) return error(http::status::method_not_allowed, "POST a recording here");
+      if (req.method() != http::verb::post)
+        return error(http::status::method_not_allowed, "POST a recording here");
       if (!trusted) return error(http::status::forbidden, "cross-origin upload refused");
       return upload(target);
     }
@@ -457,7 +482,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   }
 
   void upload(const std::string& target) {
-    if (srv_.uploads > 0) return error(http::status::service_unavailable, "another recording is being read; try again");
+    if (srv_.uploads > 0)
+      return error(http::status::service_unavailable, "another recording is being read; try again");
     if (auto len = header_->content_length(); len && *len > srv_.cfg.max_upload_bytes)
       return error(http::status::payload_too_large, too_big_message());
     std::string name = query_param(target, "name");
@@ -478,34 +504,40 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     srv_.uploads++;
     stream_.expires_after(kUploadTimeout);
-    http::async_read(stream_, buf_, *body_, [self = shared_from_this(), name](beast::error_code ec, std::size_t) {
-      self->body_->get().body().close();
-      if (ec) {
-        self->srv_.uploads--;
-        self->remove_file();
-        if (ec == http::error::body_limit) return self->error(http::status::payload_too_large, self->too_big_message());
-        return self->close();
-      }
-      const bool keep = self->body_->get().keep_alive();
-      const unsigned version = self->body_->get().version();
-      auto respond = [self, keep, version](int status, std::string json) {
-        asio::post(self->srv_.io, [self, keep, version, status, json = std::move(json)]() mutable {
-          self->srv_.uploads--;
-          self->remove_file();
-          http::response<http::string_body> res{static_cast<http::status>(status), version};
-          headers(res, "application/json", keep);
-          res.body() = std::move(json);
-          res.prepare_payload();
-          self->respond(std::move(res));
+    http::async_read(
+        stream_, buf_, *body_,
+        [self = shared_from_this(), name](beast::error_code ec, std::size_t) {
+          self->body_->get().body().close();
+          if (ec) {
+            self->srv_.uploads--;
+            self->remove_file();
+            if (ec == http::error::body_limit)
+              return self->error(http::status::payload_too_large, self->too_big_message());
+            return self->close();
+          }
+          const bool keep = self->body_->get().keep_alive();
+          const unsigned version = self->body_->get().version();
+          auto respond = [self, keep, version](int status, std::string json) {
+            asio::post(
+                self->srv_.io, [self, keep, version, status, json = std::move(json)]() mutable {
+                  self->srv_.uploads--;
+                  self->remove_file();
+                  http::response<http::string_body> res{static_cast<http::status>(status), version};
+                  headers(res, "application/json", keep);
+                  res.body() = std::move(json);
+                  res.prepare_payload();
+                  self->respond(std::move(res));
+                });
+          };
+          if (!self->srv_.hooks.on_upload)
+            return respond(500, json_error("uploads are not handled"));
+          self->srv_.hooks.on_upload(self->file_, name, std::move(respond));
         });
-      };
-      if (!self->srv_.hooks.on_upload) return respond(500, json_error("uploads are not handled"));
-      self->srv_.hooks.on_upload(self->file_, name, std::move(respond));
-    });
   }
 
   std::string too_big_message() const {
-    return "recording over the " + std::to_string(srv_.cfg.max_upload_bytes >> 20) + " MiB limit (--web-max-upload-mb)";
+    return "recording over the " + std::to_string(srv_.cfg.max_upload_bytes >> 20) +
+           " MiB limit (--web-max-upload-mb)";
   }
 
   void remove_file() {
@@ -528,10 +560,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void respond(http::response<Body>&& res) {
     auto sp = std::make_shared<http::response<Body>>(std::move(res));
     stream_.expires_after(kHttpTimeout);
-    http::async_write(stream_, *sp, [self = shared_from_this(), sp](beast::error_code ec, std::size_t) {
-      if (ec || !sp->keep_alive()) return self->close();
-      self->read();
-    });
+    http::async_write(stream_, *sp,
+                      [self = shared_from_this(), sp](beast::error_code ec, std::size_t) {
+                        if (ec || !sp->keep_alive()) return self->close();
+                        self->read();
+                      });
   }
 
   void close() {
@@ -590,7 +623,8 @@ int WebServer::port() const { return impl_->acceptor.local_endpoint().port(); }
 
 std::string WebServer::url() const {
   const auto ep = impl_->acceptor.local_endpoint();
-  const std::string host = ep.address().is_v6() ? "[" + ep.address().to_string() + "]" : ep.address().to_string();
+  const std::string host =
+      ep.address().is_v6() ? "[" + ep.address().to_string() + "]" : ep.address().to_string();
   return "http://" + host + ":" + std::to_string(ep.port()) + "/";
 }
 
@@ -618,7 +652,8 @@ void WebServer::run(const std::function<bool()>& should_stop) {
 void WebServer::post(std::function<void()> fn) { asio::post(impl_->io, std::move(fn)); }
 
 WebServer::Counters WebServer::counters() const {
-  return {impl_->n.http_requests, impl_->n.http_errors, impl_->n.ws_opened, impl_->n.ws_closed, impl_->n.too_big};
+  return {impl_->n.http_requests, impl_->n.http_errors, impl_->n.ws_opened, impl_->n.ws_closed,
+          impl_->n.too_big};
 }
 
 }  // namespace ddswarm::gs::web

@@ -20,7 +20,8 @@ struct WebServerConfig {
   std::filesystem::path web_root;     ///< the page's files (index.html, node_modules/three)
   bool allow_remote = false;          ///< listen on a non-loopback address
   std::uint64_t max_upload_bytes = 512ull << 20;  ///< largest recording upload, bytes, >= 1 MiB
-  /// Throws ConfigError naming the field and value (e.g. a non-loopback address without allow_remote).
+  /// Throws ConfigError naming the field and value (e.g. a non-loopback address without
+  /// allow_remote).
   void validate() const;
 };
 
@@ -34,7 +35,8 @@ std::filesystem::path default_web_root();
 /// Maps a request target to a file under root: "/" is index.html, "/vendor/three/X"
 /// is node_modules/three/X. Percent-escapes are decoded; "..", backslashes, NUL and
 /// anything resolving outside root give nullopt. The file must exist.
-std::optional<std::filesystem::path> resolve_static_path(const std::filesystem::path& root, std::string_view target);
+std::optional<std::filesystem::path> resolve_static_path(const std::filesystem::path& root,
+                                                         std::string_view target);
 
 /// The Content-Type for a file name, e.g. "text/javascript; charset=utf-8".
 std::string mime_type(const std::filesystem::path& file);

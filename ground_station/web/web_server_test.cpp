@@ -42,13 +42,15 @@ TEST_F(StaticFiles, ServesFilesUnderTheRootAndThreeUnderVendor) {
   EXPECT_EQ(get("/index.html?x=1"), canon(root_ / "index.html"));
   EXPECT_EQ(get("/js/app.js"), canon(root_ / "js/app.js"));
   EXPECT_EQ(get("/js/%61pp.js"), canon(root_ / "js/app.js"));
-  EXPECT_EQ(get("/vendor/three/build/three.module.js"), canon(root_ / "node_modules/three/build/three.module.js"));
+  EXPECT_EQ(get("/vendor/three/build/three.module.js"),
+            canon(root_ / "node_modules/three/build/three.module.js"));
 }
 
 TEST_F(StaticFiles, RefusesTraversalHiddenFilesAndEscapes) {
-  for (const char* t : {"/../outside.txt", "/js/../../outside.txt", "/%2e%2e/outside.txt", "/js/%2E%2E/%2E%2E/outside.txt",
-                        "/vendor/three/../../../outside.txt", "/.secret", "/js\\..\\..\\outside.txt", "/link.txt",
-                        "/missing.js", "relative", "", "/%zz", "/%2", "/js/app.js%00.png", "/js"})
+  for (const char* t : {"/../outside.txt", "/js/../../outside.txt", "/%2e%2e/outside.txt",
+                        "/js/%2E%2E/%2E%2E/outside.txt", "/vendor/three/../../../outside.txt",
+                        "/.secret", "/js\\..\\..\\outside.txt", "/link.txt", "/missing.js",
+                        "relative", "", "/%zz", "/%2", "/js/app.js%00.png", "/js"})
     EXPECT_FALSE(get(t).has_value()) << t;
 }
 
@@ -79,8 +81,8 @@ TEST(WebServer, ListenAddress) {
   parse_listen_address("[::1]:8080", c);
   EXPECT_EQ(c.address, "::1");
   EXPECT_EQ(c.port, 8080);
-  for (const char* bad : {"8080", "127.0.0.1", "127.0.0.1:", "127.0.0.1:65536", "127.0.0.1:-1", "localhost:80",
-                          "127.0.0.1:80x", "::1:80", "1.2.3:80"}) {
+  for (const char* bad : {"8080", "127.0.0.1", "127.0.0.1:", "127.0.0.1:65536", "127.0.0.1:-1",
+                          "localhost:80", "127.0.0.1:80x", "::1:80", "1.2.3:80"}) {
     try {
       parse_listen_address(bad, c);
       ADD_FAILURE() << bad << " accepted";

@@ -22,8 +22,10 @@ namespace {
 template <class T>
 std::vector<std::uint8_t> to_cdr(const T& sample) {
   typename Topic<T>::PubSub type;
-  eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(const_cast<T*>(&sample))());
-  if (!type.serialize(const_cast<T*>(&sample), &payload)) throw std::runtime_error("cannot serialize");
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(
+      type.getSerializedSizeProvider(const_cast<T*>(&sample))());
+  if (!type.serialize(const_cast<T*>(&sample), &payload))
+    throw std::runtime_error("cannot serialize");
   return std::vector<std::uint8_t>(payload.data, payload.data + payload.length);
 }
 template <class T>

@@ -15,11 +15,11 @@
 #include <cstdio>
 #include <vector>
 
-#include "tests/fuzz/fuzz_check.hpp"
 #include "agent/mission_fsm.hpp"
 #include "common/convert.hpp"
 #include "common/topics.hpp"
 #include "sim_server/command_gate.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 using namespace ddswarm;
 
@@ -44,7 +44,8 @@ void velocity_command(FuzzedDataProvider& fdp) {
   auto bytes = fdp.ConsumeRemainingBytes<std::uint8_t>();
   msg::VelocityCommand c;
   if (!deserialise(bytes, c)) return;  // refused by the wire layer: never reaches the gate
-  sim::CommandFacts f{c.drone_id(), c.tick(), from_msg(c.velocity()), c.yaw_rate_rad_s(), c.agent_instance()};
+  sim::CommandFacts f{c.drone_id(), c.tick(), from_msg(c.velocity()), c.yaw_rate_rad_s(),
+                      c.agent_instance()};
   const sim::Verdict v = sim::check_command(f, g);
   FUZZ_CHECK(sim::to_string(v) != nullptr);
   if (v != sim::Verdict::kAccept) return;
@@ -69,7 +70,8 @@ void mission_command(FuzzedDataProvider& fdp) {
   if (!deserialise(bytes, m)) return;
   if (!mission_problem(m).empty()) return;  // rejected and counted by server and agents
   FUZZ_CHECK(m.type() >= 1 && m.type() <= 8);
-  FUZZ_CHECK(std::isfinite(m.value()) && std::isfinite(m.duration_s()) && std::isfinite(m.epsilon_m()));
+  FUZZ_CHECK(std::isfinite(m.value()) && std::isfinite(m.duration_s()) &&
+             std::isfinite(m.epsilon_m()));
   FUZZ_CHECK(from_msg(m.velocity()).allFinite());
 
   agent::AgentConfig cfg;

@@ -18,7 +18,8 @@ namespace {
 
 std::string scratch_path() {
   const char* dir = std::getenv("TMPDIR");
-  return std::string(dir ? dir : "/tmp") + "/ddswarm_fuzz_config_" + std::to_string(::getpid()) + ".yaml";
+  return std::string(dir ? dir : "/tmp") + "/ddswarm_fuzz_config_" + std::to_string(::getpid()) +
+         ".yaml";
 }
 
 void expect_one_line(const ddswarm::ConfigError& e) {

@@ -16,9 +16,9 @@
 #include <tuple>
 #include <vector>
 
-#include "tests/fuzz/fuzz_check.hpp"
 #include "common/mcap/mcap_reader.hpp"
 #include "common/mcap/mcap_writer.hpp"
+#include "tests/fuzz/fuzz_check.hpp"
 
 using namespace ddswarm::mcap;
 
@@ -26,12 +26,16 @@ namespace {
 
 std::string scratch(const char* what) {
   const char* dir = std::getenv("TMPDIR");
-  return std::string(dir ? dir : "/tmp") + "/ddswarm_fuzz_mcap_" + std::to_string(::getpid()) + what;
+  return std::string(dir ? dir : "/tmp") + "/ddswarm_fuzz_mcap_" + std::to_string(::getpid()) +
+         what;
 }
 
-using Key = std::tuple<std::uint64_t, std::uint16_t, std::uint32_t, std::uint64_t, std::vector<std::uint8_t>>;
+using Key = std::tuple<std::uint64_t, std::uint16_t, std::uint32_t, std::uint64_t,
+                       std::vector<std::uint8_t>>;
 
-Key key(const Message& m) { return {m.log_time_ns, m.channel_id, m.sequence, m.publish_time_ns, m.data}; }
+Key key(const Message& m) {
+  return {m.log_time_ns, m.channel_id, m.sequence, m.publish_time_ns, m.data};
+}
 
 std::vector<Key> sorted_keys(const std::vector<Message>& ms) {
   std::vector<Key> out;
@@ -50,11 +54,13 @@ void round_trip(FuzzedDataProvider& fdp) {
   std::vector<Message> written;
   {
     Writer w(path, opt);
-    const auto schema = w.add_schema("ddswarm::msg::DroneState", "omgidl", fdp.ConsumeRandomLengthString(64));
+    const auto schema =
+        w.add_schema("ddswarm::msg::DroneState", "omgidl", fdp.ConsumeRandomLengthString(64));
     std::vector<std::uint16_t> channels;
     const int n_channels = fdp.ConsumeIntegralInRange(1, 4);
     for (int i = 0; i < n_channels; ++i)
-      channels.push_back(w.add_channel(fdp.ConsumeBool() ? schema : 0, fdp.ConsumeRandomLengthString(32), "cdr",
+      channels.push_back(w.add_channel(fdp.ConsumeBool() ? schema : 0,
+                                       fdp.ConsumeRandomLengthString(32), "cdr",
                                        {{"k", fdp.ConsumeRandomLengthString(8)}}));
     std::uint64_t t = fdp.ConsumeIntegral<std::uint32_t>();
     const int n = fdp.ConsumeIntegralInRange(0, 200);
@@ -62,13 +68,15 @@ void round_trip(FuzzedDataProvider& fdp) {
       Message m;
       m.channel_id = channels[fdp.ConsumeIntegralInRange<std::size_t>(0, channels.size() - 1)];
       // Times may go backwards (a late sample): the reader sorts within a chunk.
-      t = fdp.ConsumeBool() ? t + fdp.ConsumeIntegral<std::uint16_t>() : t - std::min<std::uint64_t>(t, fdp.ConsumeIntegral<std::uint8_t>());
+      t = fdp.ConsumeBool() ? t + fdp.ConsumeIntegral<std::uint16_t>()
+                            : t - std::min<std::uint64_t>(t, fdp.ConsumeIntegral<std::uint8_t>());
       m.log_time_ns = t;
       m.publish_time_ns = fdp.ConsumeIntegral<std::uint64_t>();
       m.sequence = fdp.ConsumeIntegral<std::uint32_t>();
       const std::string payload = fdp.ConsumeRandomLengthString(512);
       m.data.assign(payload.begin(), payload.end());
-      w.write(m.channel_id, m.log_time_ns, m.publish_time_ns, m.data.data(), m.data.size(), m.sequence);
+      w.write(m.channel_id, m.log_time_ns, m.publish_time_ns, m.data.data(), m.data.size(),
+              m.sequence);
       written.push_back(m);
     }
     w.close();
@@ -85,7 +93,8 @@ void round_trip(FuzzedDataProvider& fdp) {
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec || size < 8 + 20) return;
-  std::filesystem::resize_file(path, size - 8, ec);  // drop the trailing magic: the summary is not trusted
+  std::filesystem::resize_file(path, size - 8,
+                               ec);  // drop the trailing magic: the summary is not trusted
   FUZZ_CHECK(!ec);
   Reader scanned(path);
   FUZZ_CHECK(!scanned.how_read().from_summary);
