@@ -34,11 +34,16 @@ void ServerOutbox::per_drone(const msg::SwarmState& m, bool scan_tick) {
 }
 
 void ServerOutbox::task(const TaskReport& r, bool changed, double now) {
-  if (!changed && !(r.phase == TaskPhase::kRunning && now - last_task_publish_wall_ > 0.5) &&
+  // The topic is latched (transient-local): it has a value from the first
+  // tick, so a tool that joins before any task knows there is none at once
+  // rather than after waiting out its patience for a sample.
+  if (task_published_ && !changed &&
+      !(r.phase == TaskPhase::kRunning && now - last_task_publish_wall_ > 0.5) &&
       r.phase == last_task_phase_)
     return;
   if (r.phase == TaskPhase::kRunning && last_task_phase_ != TaskPhase::kRunning)
     task_start_wall_ = now;
+  task_published_ = true;
   last_task_phase_ = r.phase;
   last_task_publish_wall_ = now;
   w_task_.write(task_message(r, task_start_wall_ - start_wall_, now - task_start_wall_));

@@ -61,6 +61,7 @@ class ServerOutbox {
   double start_wall_ = 0;
   double last_status_wall_ = -1e9, rtf_wall_ = 0, rtf_sim_ = 0, rtf_ = 0;
   TaskPhase last_task_phase_ = TaskPhase::kNone;
+  bool task_published_ = false;
   double task_start_wall_ = 0;
   double last_task_publish_wall_ = -1e9;
 };
