@@ -31,7 +31,7 @@ namespace {
 /// A random DDS domain in 20-79 for one test. The other unit tests that
 /// join a domain draw from elsewhere (dds_commander_test 80-99,
 /// shm_clean_test 170-219), so ctest's two at a time never share one.
-int random_test_domain() { return 20 + static_cast<int>(random_instance() % 60); }
+int random_test_domain() { return 10 + static_cast<int>(random_instance() % 20); }
 
 eprosima::fastrtps::rtps::GuidPrefix_t join_and_leave(const DdsConfig& cfg) {
   Participant p(cfg, "participant_test");

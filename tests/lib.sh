@@ -5,8 +5,25 @@ set -u
 BIN="${DDSWARM_BIN:?DDSWARM_BIN must point at the build bin directory}"
 SRC="${DDSWARM_SRC:?DDSWARM_SRC must point at the source tree}"
 WORK="$(mktemp -d /tmp/ddswarm-test.XXXXXX)"
-# Each test uses its own DDS domain so parallel tests never see each other.
-DOMAIN="${DDSWARM_DOMAIN:-$(( (RANDOM % 200) + 20 ))}"
+# Each test claims its own block of DDS domains, so tests that run at once
+# (ctest -j) never see each other: an flock on a file per block, held by this
+# shell (and the processes it starts) until the test ends, even by SIGKILL.
+# DOMAIN is the block's first domain; a test may use the next ones too
+# (DDSWARM_DOMAIN_POOL "first last step": the blocks it draws from). The
+# pools stay clear of the unit tests' domains (docs/testing.md).
+claim_domain_block() {
+  local first last step d
+  read -r first last step <<<"${DDSWARM_DOMAIN_POOL:-30 87 3}"
+  mkdir -p /tmp/ddswarm-test-domains
+  for d in $(seq "$first" "$step" "$last"); do
+    exec {DOMAIN_LOCK_FD}>"/tmp/ddswarm-test-domains/$d.lock"
+    if flock -n "$DOMAIN_LOCK_FD"; then DOMAIN=$d; return 0; fi
+    exec {DOMAIN_LOCK_FD}>&-
+  done
+  echo "FAIL: every test domain block in ${first}-${last} is held by a running test"
+  exit 1
+}
+if [ -n "${DDSWARM_DOMAIN:-}" ]; then DOMAIN="$DDSWARM_DOMAIN"; else claim_domain_block; fi
 # Sanitizer builds run several times slower: scale wall-clock bounds with slow N.
 SLOWDOWN="${DDSWARM_SLOWDOWN:-1}"
 slow() { echo $(( $1 * SLOWDOWN )); }
@@ -35,6 +52,10 @@ cleanup() {
     kill -KILL "$pid" 2>/dev/null
     wait "$pid" 2>/dev/null
   done
+  # What the test and every process it waited for cost, for ctest's
+  # scheduling (tests/CMakeLists.txt, heavy tests): user and system seconds.
+  times >"$WORK/.times"  # the builtin, in this shell (a $(...) would be a subshell's)
+  echo "cpu: $(tail -1 "$WORK/.times") in ${SECONDS} s"
   if [ $rc -ne 0 ]; then
     echo "FAILED (exit $rc); process logs follow"
     print_logs
@@ -113,6 +134,16 @@ probe_swarm() {
   PROBE_LINE=$(grep "^probe ok=1" "$WORK/probe.out") || fail "the probe did not measure the swarm"
 }
 probe_val() { echo "$PROBE_LINE" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
+# commands_fresh: after probe_swarm of a plain real-time swarm, its commands
+# act on the next period (median age 1), in real time, none going stale and
+# few missed. Bounds for a test that may share 2 cores with another: the
+# figures on a quiet machine are a benchmark's (bench/swarm_bench.sh).
+commands_fresh() {
+  [ "$(probe_val age_p50_periods)" -le 1 ] || fail "command age p50 $(probe_val age_p50_periods) periods"
+  [ "$(probe_val age_p99_periods)" -le 5 ] || fail "command age p99 $(probe_val age_p99_periods) periods"
+  echo "$(probe_val rtf) >= 0.9" | bc -l | grep -q 1 || fail "real-time factor $(probe_val rtf)"
+  awk -v m="$(probe_val missed_frac)" 'BEGIN { exit !(m < 0.05) }' || fail "missed $(probe_val missed_frac) of commands"
+}
 
 # unmatched_profiles OUT ENDPOINT:PROFILE...: the shipped QoS profiles with
 # EXCLUSIVE ownership on each named endpoint (e.g. data_writer:command), so

@@ -16,7 +16,7 @@ if ! ip -n "$probe" link add "ddswp$$a" type veth peer name "ddswp$$b" 2>/dev/nu
 fi
 ip netns del "$probe"  # takes the probe veth with it
 
-# A domain no other test draws (lib.sh draws 20-219): shared memory crosses namespaces.
+# A domain no other test draws (docs/testing.md): shared memory crosses namespaces.
 DDSWARM_DOMAIN="${DDSWARM_DOMAIN:-229}"
 source "$(dirname "$0")/lib.sh"
 # No shared memory for the server: its DDS traffic must be UDP, on loopback only.

@@ -9,9 +9,9 @@
 #    participant id is taken;
 #  - a discovery server, which Fast DDS 2.9 cannot secure, is refused in one
 #    line (it would abort the swarm's processes otherwise).
-# A domain whose agents' ports lie below the kernel's ephemeral range, where
-# only a participant binds them, so the duplicate is told for sure.
-DDSWARM_DOMAIN="${DDSWARM_DOMAIN:-$(( (RANDOM % 80) + 20 ))}"
+# Its domain (lib.sh's pool) puts the agents' ports below the kernel's
+# ephemeral range, where only a participant binds them, so the duplicate is
+# told for sure.
 source "$(dirname "$0")/lib.sh"
 N=24
 secure_swarm_setup $N
