@@ -23,7 +23,7 @@ t0=$SECONDS
   >"$WORK/second.out.log" 2>"$WORK/second.err.log" &
 second=$!
 PIDS+=("$second")
-wait_pid "$second" 8
+wait_pid "$second" "$(slow 20)"  # a few seconds; more beside another test on 2 cores
 rc=$?
 echo "second agent exited with $rc after $((SECONDS - t0)) s; its stderr:"
 cat "$WORK/second.err.log"

@@ -21,17 +21,19 @@ gs follow --leader 0 || fail "follow"
 # Fly the leader north at 1 m/s for ~12 s, keeping the teleop link fresh.
 end=$((SECONDS + 12))
 while [ $SECONDS -lt $end ]; do gs teleop --north 1.0 >/dev/null || fail "teleop"; sleep 0.3; done
-# Stop the leader, and give the followers time to gather round it.
+# Stop the leader, and wait (up to 20 s) for the followers to gather round it:
+# their mean within D_int (4 m) + 1 m of it.
 gs teleop --north 0 >/dev/null || fail "teleop stop"
-sleep 8
-centroid; l1=$LEADER_Y; c1=$FOLLOWERS_Y
+gathered() { awk -v b="$LEADER_Y" -v d="$FOLLOWERS_Y" 'BEGIN{x = b - d; if (x < 0) x = -x; exit !(x < 5.0)}'; }
+end=$((SECONDS + 20))
+while centroid && ! gathered && [ $SECONDS -lt $end ]; do sleep 0.5; done
+l1=$LEADER_Y; c1=$FOLLOWERS_Y
 echo "leader y $l0 -> $l1, followers' mean y $c0 -> $c1"
 awk -v a="$l0" -v b="$l1" 'BEGIN{exit !(b - a > 4.0)}' || fail "the leader did not fly north"
 # The followers came along and gathered round their leader: their mean is
 # within D_int (4 m) + 1 m of it.
 awk -v c="$c0" -v d="$c1" 'BEGIN{exit !(d - c > 4.0)}' || fail "the followers stayed behind"
-awk -v b="$l1" -v d="$c1" 'BEGIN{x = b - d; if (x < 0) x = -x; exit !(x < 5.0)}' \
-  || fail "the followers did not gather round their leader"
+gathered || fail "the followers did not gather round their leader within 20 s"
 out=$(gs hold 2>&1) || fail "hold after follow: $out"
 gs status --drones
 echo PASS
