@@ -348,6 +348,32 @@ bool DdsCommander::wait_for_server(double timeout_s) {
   return !stop_requested();
 }
 
+ServerSearch server_search(const std::vector<ServerPeer>& servers, bool secure, bool status_heard) {
+  using State = ServerSearch::State;
+  if (status_heard) return {State::kHeard, "its status heard"};
+  if (servers.empty()) return {State::kNothing, "no server's participant discovered"};
+  const ServerPeer& newest = servers.back();
+  const std::string ago = fmt::format("{:.0f} s ago", newest.announced_s);
+  if (secure && newest.authenticated_after_s < 0)
+    return {State::kComingUp,
+            "a server's participant discovered " + ago + ", its DDS Security handshake not passed"};
+  return {State::kComingUp,
+          "a server's participant discovered " + ago + ", none of its status heard yet"};
+}
+
+ServerSearch DdsCommander::server_search() const {
+  auto& I = *impl_;
+  bool heard = false;
+  {
+    std::lock_guard<std::mutex> lock(I.mu);
+    heard = I.sim.has_value();
+  }
+  std::vector<ServerPeer> servers;
+  for (const auto& p : I.dds.peers_named(kServerParticipantName))
+    servers.push_back({p.announced_s, p.authenticated_after_s});
+  return ddswarm::gs::server_search(servers, I.dds.secure(), heard);
+}
+
 bool DdsCommander::wait_for_status(double timeout_s) {
   return impl_->wait(timeout_s, [&] { return impl_->sim.has_value(); });
 }

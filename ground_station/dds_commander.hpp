@@ -5,6 +5,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "common/dds_config.hpp"
@@ -56,6 +57,29 @@ struct ClimbWord {
 /// take-offs (docs/performance.md).
 bool climb_over(const ClimbWord& w);
 
+/// What a ground station found while it looked for the server: nothing, or
+/// a server still coming up (its participant discovered, its handshake or
+/// its endpoints not through yet), or a server it hears.
+struct ServerSearch {
+  enum class State { kNothing, kComingUp, kHeard };
+  State state = State::kNothing;
+  std::string found;  ///< one clause for an error line: what was found, what was not
+};
+/// A server participant discovery announced (RemotePeer, common/participant.hpp).
+struct ServerPeer {
+  double announced_s;            ///< since its announcement
+  double authenticated_after_s;  ///< < 0 while its handshake has not passed
+};
+/// From the server participants discovered, oldest first, whether DDS
+/// Security is on, and whether the server's status was heard.
+ServerSearch server_search(const std::vector<ServerPeer>& servers, bool secure, bool status_heard);
+
+/// s: how much longer than its discovery timeout a ground station waits for
+/// a server that is coming up (ServerSearch::kComingUp). A secure swarm of
+/// 48 agent processes on 2 cores keeps the server busy with handshakes past
+/// the default 10 s; a handshake Fast DDS leaves pending for good stops here.
+constexpr double kServerComingUpS = 120.0;
+
 class DdsCommander final : public Commander {
  public:
   DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds);
@@ -78,6 +102,8 @@ class DdsCommander final : public Commander {
   bool wait_for_server(double timeout_s);
   /// Waits until a SimStatus arrives (a live server or a replay). False on timeout.
   bool wait_for_status(double timeout_s);
+  /// What this process found of the server so far (server_search).
+  ServerSearch server_search() const;
   /// Waits until sim time reaches t (s). False on timeout (wall) or stop.
   bool wait_sim_time(double t, double timeout_s);
   /// Waits until `airborne` drones are airborne (or on the ground when 0).

@@ -119,6 +119,44 @@ TEST(ClimbOver, EitherWordPastTheClimbEndsIt) {
 
 // An experiment's run whose server died at start-up: the wait ends at once,
 // not after its timeout (which would cost a minute per run).
+// "No server" only when none was discovered: a server whose participant is
+// known but not yet heard (a secure handshake, endpoints still matching) is
+// coming up, and a ground station waits on for it (join_swarm).
+TEST(ServerSearch, TellsNothingThereFromStillComingUp) {
+  using State = ServerSearch::State;
+  auto none = server_search({}, false, false);
+  EXPECT_EQ(none.state, State::kNothing);
+  EXPECT_EQ(none.found, "no server's participant discovered");
+  auto handshaking = server_search({{12.4, -1}}, true, false);
+  EXPECT_EQ(handshaking.state, State::kComingUp);
+  EXPECT_EQ(handshaking.found,
+            "a server's participant discovered 12 s ago, its DDS Security handshake not passed");
+  // The newest of two (a restarted server): oldest first, as peers_named gives them.
+  auto matching = server_search({{30, 0.5}, {3, 0.2}}, true, false);
+  EXPECT_EQ(matching.state, State::kComingUp);
+  EXPECT_EQ(matching.found,
+            "a server's participant discovered 3 s ago, none of its status heard yet");
+  EXPECT_EQ(server_search({{3, -1}}, false, false).found,
+            "a server's participant discovered 3 s ago, none of its status heard yet");
+  EXPECT_EQ(server_search({{3, -1}}, true, true).state, State::kHeard);
+}
+
+// On an empty domain the search finds nothing; a server's participant that
+// has not published its status yet is one coming up.
+TEST(DdsCommander, TellsAnEmptyDomainFromAServerComingUp) {
+  DdsConfig cfg;
+  cfg.domain_id = random_test_domain();
+  DdsCommander gs(GroundStationConfig{}, cfg);
+  EXPECT_FALSE(gs.wait_for_server(0.5));
+  EXPECT_EQ(gs.server_search().state, ServerSearch::State::kNothing);
+  Participant server(cfg, kServerParticipantName);  // no status writer yet
+  const double until = wall_seconds() + 10;
+  while (gs.server_search().state == ServerSearch::State::kNothing && wall_seconds() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(gs.server_search().state, ServerSearch::State::kComingUp);
+  EXPECT_FALSE(gs.wait_for_server(0.3));
+}
+
 TEST(DdsCommander, StopsWaitingForTheSwarmWhenToldToGiveUp) {
   DdsConfig cfg;
   cfg.domain_id = random_test_domain();

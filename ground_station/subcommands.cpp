@@ -188,15 +188,23 @@ int run_gs(CLI::App& app, GsCommandLine& cl) {
   // outlive, so that no peer's lease timer for it fires as it leaves: in
   // Fast DDS 2.9.1 that race aborts the peer (kOneShotLeaseS, docs/dds.md).
   if (!interactive) file.dds = one_shot(file.dds);
+  // wait-agents --timeout T gives the server T to appear, too: the launcher's
+  // and the experiment runner's waits are the ones in force.
+  if (*cl.wait_agents)
+    file.gs.discovery_timeout_s = std::max(file.gs.discovery_timeout_s, cl.wait_timeout);
   // Status needs only the clock (a replayed recording has no server to command).
   bool ready = false;
   auto commander = join_swarm(file, *cl.status || (*cl.task && cl.attach), ready);
   DdsCommander& gs = *commander;
   if (!ready && !interactive) {
     if (stop_requested()) return 1;  // interrupted while discovering: reported below
+    const ServerSearch s = gs.server_search();
     std::fprintf(stderr,
-                 "ddswarm-gs: error: no simulation server found on domain %d within %.0f s\n",
-                 file.dds.domain_id, file.gs.discovery_timeout_s);
+                 "ddswarm-gs: error: no simulation server found on domain %d within %.0f s: %s\n",
+                 file.dds.domain_id,
+                 file.gs.discovery_timeout_s +
+                     (s.state == ServerSearch::State::kComingUp ? kServerComingUpS : 0.0),
+                 s.found.c_str());
     return 1;
   }
   if (interactive) return console(std::move(commander), file);
@@ -331,6 +339,18 @@ std::unique_ptr<DdsCommander> join_swarm(const GsFileConfig& file, bool wait_for
   });
   if (!commander)
     commander = std::make_unique<DdsCommander>(file.gs, file.dds);  // stopped before joining
+  // A server on its way (its participant discovered, its handshake or its
+  // endpoints not through yet) is not "no server": under a secure swarm's
+  // bring-up the server may be busy with handshakes for tens of seconds.
+  if (!ready && !stop_requested()) {
+    const ServerSearch s = commander->server_search();
+    if (s.state == ServerSearch::State::kComingUp) {
+      std::fprintf(stderr, "ddswarm-gs: %s after %.0f s; waiting up to %.0f s more\n",
+                   s.found.c_str(), file.gs.discovery_timeout_s, kServerComingUpS);
+      ready = wait_for_status ? commander->wait_for_status(kServerComingUpS)
+                              : commander->wait_for_server(kServerComingUpS);
+    }
+  }
   return commander;
 }
 
