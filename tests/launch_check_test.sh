@@ -101,6 +101,13 @@ refused "experiment set" \
 refused "experiment --set" "ddswarm-gs: error: --set sensors.count=100000: must be in [1, 64]" \
   experiment --out "$WORK/exp2" --set sensors.count=100000
 [ ! -e "$WORK/exp1/bad.csv" ] && [ ! -e "$WORK/exp1/logs" ] || problems+=("the bad experiment ran a run")
+# A bad value of the experiment's scenario file itself names that file and its line, and the
+# set that changed its section.
+sed "s|scenario: .*|scenario: $WORK/bad.yaml|; s|agent.inter_distance_m: [0-9]*|agent.max_speed_mps: 2|" \
+  "$WORK/exp.yaml" >"$WORK/exp-badfile.yaml"
+refused "experiment scenario file" \
+  "ddswarm-gs: error: $WORK/bad.yaml:$line: agent.inter_distance_m = -1: must be > 0 (with $WORK/exp-badfile.yaml:7: set 'Good')" \
+  timeout 20 "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$WORK/exp-badfile.yaml" --out "$WORK/exp3"
 
 # The scenario's copy: kept in --log-dir, else removed at exit, whichever way the launch ends.
 # One agent on a domain without a server: it waits, and the launch ends as told.
