@@ -38,10 +38,9 @@ YAML::Node apply_overrides(YAML::Node scenario,
   if (!out || out.IsNull()) out = YAML::Node(YAML::NodeType::Map);
   for (const auto& [key, value] : overrides) {
     const auto parts = split_key_path(key);
-    if (parts.empty())
-      throw ConfigError("override " + key + ": must be a dotted key path like agent.x");
+    if (parts.empty()) throw OverrideError(key, "must be a dotted key path like agent.x");
     if (!out.IsMap())
-      throw ConfigError("override " + key + ": the scenario is " + kind(out) + ", not a mapping");
+      throw OverrideError(key, std::string("the scenario is ") + kind(out) + ", not a mapping");
     // yaml-cpp: Node assignment writes through; reset() rebinds the handle.
     YAML::Node cur;
     cur.reset(out);
@@ -53,8 +52,7 @@ YAML::Node apply_overrides(YAML::Node scenario,
         cur[parts[i]] = YAML::Node(YAML::NodeType::Map);
         next.reset(cur[parts[i]]);
       } else if (!next.IsMap()) {
-        throw ConfigError("override " + key + ": " + walked + " is " + kind(next) +
-                          ", not a mapping");
+        throw OverrideError(key, walked + " is " + kind(next) + ", not a mapping");
       }
       cur.reset(next);
     }

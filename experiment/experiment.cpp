@@ -17,9 +17,11 @@
 #include "common/config_error.hpp"
 #include "common/domain_claim.hpp"
 #include "common/process.hpp"
+#include "common/scenario_check.hpp"
 #include "experiment/report.hpp"
 #include "ground_station/gs_app.hpp"
 #include "launcher/launcher.hpp"
+#include "launcher/preflight.hpp"
 
 namespace ddswarm::gs {
 
@@ -113,38 +115,80 @@ struct RunTimes {
   double teardown_s = 0;  ///< stopping every process
 };
 
-/// A bad key or value in a set (or a --set) fails each of its runs at
-/// start-up, after a minute's wait for a swarm that never comes: the ground
-/// station, the server and an agent read each set's first run file as they
-/// will, first. Throws ConfigError "set 'S': <the reader's one-line error>".
-void check_sets(const ExperimentConfig& cfg, const std::vector<RunPlan>& plans,
-                const std::string& bin) {
+/// argv with what every process of a run on domain takes: the domain, and
+/// under DDS Security the certificates (each child takes its own role's identity).
+std::vector<std::string> with_run_dds(std::vector<std::string> a, int domain,
+                                      const ExperimentOptions& opt) {
+  a.push_back("--domain");
+  a.push_back(std::to_string(domain));
+  if (opt.dds.secure()) {
+    a.push_back("--secure");
+    a.push_back(opt.dds.security_dir);
+  }
+  return a;
+}
+
+ChildSpec server_spec(const RunPlan& p, int domain, const std::string& bin,
+                      const ExperimentOptions& opt) {
+  return {"sim", with_run_dds({bin + "/ddswarm-sim", "--scenario", p.scenario_file}, domain, opt)};
+}
+
+/// The run's agent processes: one per drone, or opt.agent_hosts hosts.
+std::vector<ChildSpec> agent_specs(const RunPlan& p, int domain, const std::string& bin,
+                                   const ExperimentOptions& opt) {
+  std::vector<ChildSpec> specs;
+  std::vector<int> ids(p.rec.drones);
+  for (int i = 0; i < p.rec.drones; ++i) ids[i] = i;
+  const auto shares = agent_host_shares(ids, opt.agent_hosts);
+  for (std::size_t h = 0; h < shares.size(); ++h)
+    specs.push_back(
+        {"agent host " + std::to_string(h),
+         with_run_dds(agent_command(bin, shares[h], true, p.scenario_file, true), domain, opt)});
+  for (int i = 0; opt.agent_hosts == 0 && i < p.rec.drones; ++i)
+    specs.push_back(
+        {"agent " + std::to_string(i),
+         with_run_dds(agent_command(bin, std::to_string(i), false, p.scenario_file, true), domain,
+                      opt)});
+  return specs;
+}
+
+/// A bad key or value in a set (or a --set) would fail each of its runs at
+/// start-up, after a minute's wait for a swarm that never comes. So each
+/// set's scenario is read first as its processes will read it: by the ground
+/// station's reader here, and by its server's and first agent's --check, on
+/// the set's first run file (its runs differ in their seed alone; a server
+/// that cannot start from a seed ends its run at once, as any process that
+/// ends before the swarm is up). Throws ConfigError naming what the user
+/// wrote: the experiment file's line and set, the --set, or the scenario
+/// file's line (explain_scenario_error).
+void check_sets(const ExperimentConfig& cfg, const std::vector<RunPlan>& plans, int domain,
+                const std::string& bin, const ExperimentOptions& opt) {
+  const YamlDocument user = YamlDocument::load_file(cfg.scenario_path);
+  std::vector<ChildSpec> checks;
+  std::vector<const RunPlan*> checked;
   for (const auto& p : plans) {
     if (p.k != 0) continue;
-    const std::string set = "set '" + cfg.sets[p.set].name + "': ";
+    const ScenarioOrigin origin{cfg.scenario_path, key_lines(user.root()),
+                                override_origins(cfg, p.set)};
     try {
       (void)load_gs_config(p.scenario_file);
-    } catch (const std::exception& e) {
-      throw ConfigError(set + e.what());
+    } catch (const ConfigError& e) {
+      throw ConfigError(explain_scenario_error(e.what(), p.scenario_file, origin));
     }
-    for (const auto& argv :
-         {std::vector<std::string>{bin + "/ddswarm-sim", "--check", "--scenario", p.scenario_file},
-          std::vector<std::string>{bin + "/ddswarm-agent", "--check", "--config",
-                                   p.scenario_file}}) {
-      std::string said;
-      const ChildExit e = run_to_end({argv[0], argv}, said);
-      if (e.exit_code == 0) continue;
-      // The reader's own error line ("ddswarm-sim: error: FILE:LINE: key = value: reason").
-      std::string line;
-      std::istringstream lines(said);
-      for (std::string l; std::getline(lines, l);)
-        if (l.find("error") != std::string::npos) {
-          line = l;
-          break;
-        }
-      throw ConfigError(set + (line.empty() ? e.describe() + ": " + said : line));
-    }
+    checks.push_back(server_spec(p, domain, bin, opt));
+    checks.push_back(agent_specs(p, domain, bin, opt).front());
+    checked.push_back(&p);
   }
+  for (auto& c : checks) c.argv.push_back("--check");
+  const std::string error = first_check_error(checks);
+  if (error.empty()) return;
+  // Each reader names the file it read: the set's.
+  for (const RunPlan* p : checked)
+    if (error.find(p->scenario_file + ":") != std::string::npos)
+      throw ConfigError(explain_scenario_error(
+          error, p->scenario_file,
+          {cfg.scenario_path, key_lines(user.root()), override_origins(cfg, p->set)}));
+  throw ConfigError(explain_scenario_error(error, "", {cfg.scenario_path, {}, {}}));
 }
 
 }  // namespace
@@ -195,30 +239,14 @@ std::vector<RunPlan> plan_runs(const ExperimentConfig& cfg, const ExperimentOpti
 /// the server, and the agents (one process each, or opt.agent_hosts hosts).
 void start_run_processes(Launcher& procs, const RunPlan& p, int domain, const std::string& bin,
                          const ExperimentOptions& opt) {
-  auto common_args = [&](std::vector<std::string> a) {
-    a.push_back("--domain");
-    a.push_back(std::to_string(domain));
-    if (opt.dds.secure()) {  // each child takes its own role's identity
-      a.push_back("--secure");
-      a.push_back(opt.dds.security_dir);
-    }
-    return a;
-  };
   if (!opt.record_dir.empty()) {
     fs::create_directories(opt.record_dir);
-    procs.start({"record", common_args({bin + "/ddswarm-record", "-o",
-                                        opt.record_dir + "/" + p.tag + ".mcap"})});
+    procs.start({"record", with_run_dds({bin + "/ddswarm-record", "-o",
+                                         opt.record_dir + "/" + p.tag + ".mcap"},
+                                        domain, opt)});
   }
-  procs.start({"sim", common_args({bin + "/ddswarm-sim", "--scenario", p.scenario_file})});
-  std::vector<int> ids(p.rec.drones);
-  for (int i = 0; i < p.rec.drones; ++i) ids[i] = i;
-  const auto shares = agent_host_shares(ids, opt.agent_hosts);
-  for (std::size_t h = 0; h < shares.size(); ++h)
-    procs.start({"agent host " + std::to_string(h),
-                 common_args(agent_command(bin, shares[h], true, p.scenario_file, true))});
-  for (int i = 0; opt.agent_hosts == 0 && i < p.rec.drones; ++i)
-    procs.start({"agent " + std::to_string(i),
-                 common_args(agent_command(bin, std::to_string(i), false, p.scenario_file, true))});
+  procs.start(server_spec(p, domain, bin, opt));
+  for (const auto& spec : agent_specs(p, domain, bin, opt)) procs.start(spec);
 }
 
 /// How one start of a run ended: its outcome, and the processes that ended
@@ -432,7 +460,7 @@ int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, st
   const double t0 = wall_seconds();
 
   std::vector<RunPlan> plans = plan_runs(cfg, opt);
-  check_sets(cfg, plans, bin);
+  check_sets(cfg, plans, domains.front().domain(), bin, opt);
   out << fmt::format("experiment '{}': {} sets x {} runs, {} mode, {} at a time, results in {}\n",
                      cfg.name, cfg.sets.size(), cfg.runs_per_set, cfg.mode, jobs, opt.out_dir);
   for (const auto& why : skipped) out << "  not on " << why << "\n";

@@ -1,5 +1,6 @@
 #include "experiment/experiment_config.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
@@ -65,6 +66,7 @@ void load(YamlSection s, ExperimentConfig& c, const std::string& base_dir) {
         const std::string key = it->first.Scalar();
         if (!e.overrides.emplace(key, YAML::Clone(it->second)).second)
           overrides.fail(it->first, key, YAML::Dump(it->second), "set twice");
+        e.lines[key] = it->first.Mark().line + 1;
       }
     }
     set.finish();
@@ -83,6 +85,7 @@ namespace {
 ExperimentConfig from_document(const YamlDocument& doc) {
   YamlSection root(doc.root(), doc.file(), "");
   ExperimentConfig c;
+  c.file = doc.file();
   doc.guard([&] {
     if (!root.has("experiment")) throw ConfigError(doc.file() + ":1: no `experiment:` section");
     load(root.child("experiment"), c, fs::path(doc.file()).parent_path().string());
@@ -109,22 +112,40 @@ void override_every_set(ExperimentConfig& c, const std::map<std::string, YAML::N
       // anything under or above it (validate() rejects a key and its child).
       // (kv, not a structured binding: clang 14, the fuzz build, cannot capture one.)
       const std::string& key = kv.first;
-      std::erase_if(set.overrides, [&](const auto& o) {
+      const auto replaced = [&](const auto& o) {
         return o.first == key || o.first.starts_with(key + ".") || key.starts_with(o.first + ".");
-      });
+      };
+      std::erase_if(set.overrides, replaced);
+      std::erase_if(set.lines, replaced);
       set.overrides[key] = YAML::Clone(kv.second);
     }
   }
   c.validate();
 }
 
-YAML::Node scenario_for_set(const ExperimentConfig& c, std::size_t set_index) {
+std::vector<OverrideOrigin> override_origins(const ExperimentConfig& c, std::size_t set_index) {
   const ExperimentSet& set = c.sets.at(set_index);
+  std::vector<OverrideOrigin> out;
+  for (const auto& [key, value] : set.overrides) {
+    if (const auto it = set.lines.find(key); it != set.lines.end()) {
+      out.push_back({key, c.file + ":" + std::to_string(it->second) + ": set '" + set.name + "'"});
+    } else {
+      std::string text = value.IsScalar() ? value.Scalar() : YAML::Dump(value);
+      std::replace(text.begin(), text.end(), '\n', ' ');
+      out.push_back({key, "--set " + key + "=" + text, true});
+    }
+  }
+  return out;
+}
+
+YAML::Node scenario_for_set(const ExperimentConfig& c, std::size_t set_index) {
   const YamlDocument doc = YamlDocument::load_file(c.scenario_path);
   try {
-    return apply_overrides(doc.root(), set.overrides);
-  } catch (const ConfigError& e) {
-    throw ConfigError(c.scenario_path + ": set '" + set.name + "': " + e.what());
+    return apply_overrides(doc.root(), c.sets.at(set_index).overrides);
+  } catch (const OverrideError& e) {
+    for (const auto& o : override_origins(c, set_index))
+      if (o.key == e.key()) throw ConfigError(o.where + ": " + e.key() + ": " + e.reason());
+    throw;
   }
 }
 

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "common/scenario_check.hpp"
 #include "common/scenario_overrides.hpp"  // apply_overrides, parse_set_options
 #include "common/yaml_section.hpp"
 
@@ -36,9 +37,13 @@ namespace ddswarm::gs {
 struct ExperimentSet {
   std::string name;                             ///< column title, e.g. "Sim 1"; unique, non-empty
   std::map<std::string, YAML::Node> overrides;  ///< dotted scenario key -> value
+  /// Line in the experiment file of each override written there; one
+  /// without a line came from the command line (override_every_set).
+  std::map<std::string, int> lines;
 };
 
 struct ExperimentConfig {
+  std::string file;                 ///< the experiment file, as named (errors name it)
   std::string name = "experiment";  ///< used in output file names, non-empty
   std::string scenario;             ///< scenario file as written
   std::string scenario_path;        ///< scenario file resolved against the experiment's folder
@@ -70,9 +75,14 @@ ExperimentConfig parse_experiment(const std::string& text, const std::string& fi
 /// 250 Hz); each run's CSV row records them with the set's. Validates c again.
 void override_every_set(ExperimentConfig& c, const std::map<std::string, YAML::Node>& overrides);
 
+/// Where each override of set set_index came from, as an error names it:
+/// "<experiment file>:<line>: set '<name>'" for one of the file's `set:`,
+/// "--set <key>=<value>" for one of override_every_set's.
+std::vector<OverrideOrigin> override_origins(const ExperimentConfig& c, std::size_t set_index);
+
 /// The scenario of set set_index: the scenario file with the set's overrides
-/// applied. Throws ConfigError (unreadable scenario, bad override) or
-/// std::out_of_range (set_index).
+/// applied. Throws ConfigError (unreadable scenario, bad override: naming it
+/// as override_origins does) or std::out_of_range (set_index).
 YAML::Node scenario_for_set(const ExperimentConfig& c, std::size_t set_index);
 
 }  // namespace ddswarm::gs

@@ -214,10 +214,10 @@ TEST(ApplyOverrides, ScenarioForSetReadsTheScenarioFile) {
     scenario_for_set(c, 0);
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("set 'A': override agent.inter_distance_m: agent is a "
-                                         "value"),
-              std::string::npos)
-        << e.what();
+    // Named by the experiment file's line of the override.
+    EXPECT_EQ(std::string(e.what()), (dir / "exp.yaml").string() +
+                                         ":8: set 'A': agent.inter_distance_m: agent is a value, "
+                                         "not a mapping");
   }
   fs::remove(dir / "course.yaml");
   EXPECT_THROW(scenario_for_set(c, 0), ConfigError);
@@ -245,6 +245,17 @@ TEST(ExperimentConfig, CommandLineOverridesWinInEverySet) {
   }
   EXPECT_EQ(c.sets[0].overrides.at("agent.inter_distance_m").as<double>(), 4);
   EXPECT_EQ(c.sets[1].overrides.size(), 2u);
+  // An error names each override where it was written: the file's line, or the flag.
+  const auto origins = override_origins(c, 0);
+  ASSERT_EQ(origins.size(), 3u);
+  EXPECT_EQ(origins[0].key, "agent.inter_distance_m");
+  EXPECT_EQ(origins[0].where, "/exp/table.yaml:5: set 'A'");
+  EXPECT_FALSE(origins[0].where_has_value);
+  EXPECT_EQ(origins[1].key, "agent.sensor_function.type");
+  EXPECT_EQ(origins[1].where, "--set agent.sensor_function.type=fs2");
+  EXPECT_TRUE(origins[1].where_has_value);
+  EXPECT_EQ(origins[2].where, "--set sim.physics_rate_hz=250");
+  EXPECT_EQ(override_origins(c, 1).size(), 2u);
 }
 
 TEST(ExperimentConfig, RejectsASetOptionWithoutAKey) {

@@ -20,6 +20,7 @@
 #include "common/scenario.hpp"
 #include "common/scenario_overrides.hpp"
 #include "ground_station/gs_app.hpp"
+#include "launcher/preflight.hpp"
 
 namespace ddswarm::gs {
 
@@ -68,6 +69,10 @@ void add_launch_command_line(CLI::App& app, LaunchCommandLine& cl) {
       "1.5 agent.rejoin_after_s, 90 s by default), e.g. \"takeoff --wait; task\"; "
       "everything stops when they finish");
   app.add_flag("--gs-interactive", cl.gs_interactive, "open the ground-station console here");
+  app.add_flag("--check", cl.check,
+               "check the scenario, with --set and the other options, as every process this "
+               "launch would start reads it; print one line and exit (0: valid, 2: the error); "
+               "starts nothing");
   app.add_option("--log-dir", cl.log_dir,
                  "write each process's log to DIR/<name>.log instead of the terminal");
   app.add_option("--duration", cl.duration_s, "stop everything after this many wall seconds")
@@ -105,29 +110,34 @@ double agents_wait_s(const std::string& scenario) {
   return 30.0 + std::max(longest_scene_wait_s(scenario_rejoin_after_s(scenario)), 0.0);
 }
 
-LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl) : cl_(std::move(cl)) {
-  if (!cl_.sets.empty()) {
-    derive(parse_set_options(cl_.sets), "--set overrides");
-  }
+LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl)
+    : cl_(std::move(cl)), user_scenario_(cl_.scenario) {
+  const auto sets = parse_set_options(cl_.sets);
   if (app.count("--participant-id"))
     throw FieldError(
         "--participant-id", app.get_option("--participant-id")->as<std::string>(),
         "names one process; the launcher starts many (see docs/networking.md, large swarms)");
-  auto file = load_gs_config(cl_.scenario);
+  // The user's file alone first: its syntax errors name it. Errors found in
+  // its copy are told by where their field came from (origin_).
+  const YamlDocument user = YamlDocument::load_file(user_scenario_);
+  origin_.file = user_scenario_;
+  origin_.lines = key_lines(user.root());
+  std::map<std::string, std::string> typed;  // key -> its last --set, as typed
+  for (const auto& text : cl_.sets) typed[text.substr(0, text.find('='))] = "--set " + text;
+  for (const auto& [key, where] : typed) origin_.overrides.push_back({key, where, true});
+  YAML::Node root = user.root();
+  if (!sets.empty()) {
+    try {
+      root = apply_overrides(root, sets);
+    } catch (const OverrideError& e) {
+      throw ConfigError(typed.at(e.key()) + ": " + e.reason());
+    }
+    derive(root, "--set overrides");
+  }
+  auto file = read_gs_config();
   file_dds_ = file.dds;
-  // A launch that runs a server owns its domain on this host while it runs:
-  // an experiment passes over it, and a second launch says who has it
-  // (common/domain_claim.hpp). Agents alone join a swarm; they claim nothing.
   dds_ = file.dds;
   merge_cli(dds_, cl_.dds_cli, app);
-  if (cl_.only != "agents") {
-    claim_.emplace(dds_.domain_id);
-    if (!claim_->held())
-      throw FieldError(
-          app.count("--domain") ? "--domain" : "dds.domain_id", std::to_string(dds_.domain_id),
-          "claimed on this host by " + claim_->holder() +
-              "; two swarms on one domain take each other's commands, so choose another");
-  }
   n_ = cl_.drones.value_or(file.drones);
   if (n_ < 1 || n_ > 1024) throw FieldError("--drones", std::to_string(n_), "must be in [1, 1024]");
   if (cl_.only != "server") {
@@ -175,31 +185,182 @@ LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl) : cl_(std::move(
   // agents skip their duplicate probe.
   whole_swarm_ = cl_.only == "all" && cl_.ids_text.empty();
   bin_ = Launcher::self_dir();
+  // What discovery scales with is participants: with agent hosts, a few.
+  // Not under DDS Security: Fast DDS 2.9's discovery server has none.
+  const int participants = cl_.agent_hosts > 0 ? std::min<int>(cl_.agent_hosts, n_) + 1 : n_;
+  start_ds_ = wants_local_discovery_server(ds_, participants, whole_swarm_,
+                                           localhost_discovery_ && !dds_.secure());
+  if (start_ds_) {
+    const auto for_ds = discovery_server_overrides(root);
+    if (!for_ds.empty()) {
+      std::string why;
+      for (const auto& [key, value] : for_ds) {
+        const std::string set = fmt::format("{}: {}", key, value.as<std::string>());
+        why += (why.empty() ? "" : ", ") + set;
+        origin_.overrides.push_back({key, "ddswarm-launch's " + set + " for its discovery server"});
+      }
+      derive(apply_overrides(root, for_ds),
+             (sets.empty() ? "" : "--set overrides, ") + why + " (a discovery server)");
+      (void)read_gs_config();
+    }
+  }
+  // Every process reads the same file: checked as each will read it before
+  // any starts, so a bad value is one line here, not one per process.
+  check_readers();
+  // A launch that runs a server owns its domain on this host while it runs:
+  // an experiment passes over it, and a second launch says who has it
+  // (common/domain_claim.hpp). Agents alone join a swarm; they claim nothing.
+  if (cl_.only != "agents" && !cl_.check) {
+    claim_.emplace(dds_.domain_id);
+    if (!claim_->held())
+      throw FieldError(
+          app.count("--domain") ? "--domain" : "dds.domain_id", std::to_string(dds_.domain_id),
+          "claimed on this host by " + claim_->holder() +
+              "; two swarms on one domain take each other's commands, so choose another");
+  }
+  if (!why_.empty() && !cl_.check)
+    std::cerr << "ddswarm-launch: scenario with " << why_ << " written to " << cl_.scenario
+              << (copy_.path().empty() ? "" : " (removed at exit)") << "\n";
 }
 
 bool LaunchApp::stopping() const { return stop_ || stop_requested(); }
 
-void LaunchApp::derive(const std::map<std::string, YAML::Node>& overrides, const std::string& why) {
-  YAML::Node derived = apply_overrides(YamlDocument::load_file(cl_.scenario).root(), overrides);
-  const std::string dir =
-      cl_.log_dir.empty() ? std::filesystem::temp_directory_path().string() : cl_.log_dir;
-  std::filesystem::create_directories(dir);
-  const std::string path = dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
-  std::ofstream(path) << "# " << cl_.scenario << " with " << why << "\n"
-                      << YAML::Dump(derived) << "\n";
-  std::cerr << "ddswarm-launch: scenario with " << why << " written to " << path << "\n";
+RemovedAtExit::~RemovedAtExit() {
+  std::error_code ec;
+  if (!path_.empty()) std::filesystem::remove(path_, ec);
+}
+
+void LaunchApp::derive(const YAML::Node& scenario, const std::string& why) {
+  // In the log directory it stays with the run's logs, as the record of what
+  // every process read; elsewhere it is removed at exit.
+  std::string path;
+  if (cl_.log_dir.empty()) {
+    path = (std::filesystem::temp_directory_path() /
+            ("ddswarm-scenario-" + std::to_string(getpid()) + ".yaml"))
+               .string();
+    copy_.set(path);
+  } else {
+    std::filesystem::create_directories(cl_.log_dir);
+    path = cl_.log_dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
+  }
+  std::ofstream f(path);
+  f << "# " << user_scenario_ << " with " << why << "\n" << YAML::Dump(scenario) << "\n";
+  if (!f) throw std::runtime_error("cannot write " + path);
   cl_.scenario = path;
+  why_ = why;
+}
+
+std::map<std::string, YAML::Node> LaunchApp::discovery_server_overrides(
+    const YAML::Node& root) const {
+  // A longer lease for the swarm's own participants, unless the scenario
+  // names one: under a 128-process bring-up the discovery server, short of
+  // CPU, drops datagrams, and at the default 3 s it lets the server's lease
+  // lapse and loses it for good (docs/performance.md).
+  // And ground stations patient enough for their own re-join through it
+  // (ground_station/subcommands.cpp: after 20 s without a server), which also
+  // carries them over a restart of the discovery server (docs/faults.md).
+  // And no shared-memory transport, unless the scenario names it: a
+  // sender opening a peer's port waits a third of dds.shm_health_check_s
+  // (3.3 s) whenever the port's idle listener was just checked, with
+  // every send of its participant held. In 128-process bring-ups the
+  // server stalls 10-20 s that way and loses up to 119 of 128 agents;
+  // over UDP (the swarm state still by data-sharing) it does not
+  // (docs/dds.md).
+  std::map<std::string, YAML::Node> for_ds;
+  auto unless_named = [&](const char* section, const char* key, const YAML::Node& value) {
+    if (!(root.IsMap() && root[section] && root[section].IsMap() && root[section][key]))
+      for_ds[fmt::format("{}.{}", section, key)] = value;
+  };
+  unless_named("dds", "lease_duration_s", YAML::Node(kDiscoveryServerLeaseS));
+  unless_named("dds", "shm_transport", YAML::Node(false));
+  unless_named("ground_station", "discovery_timeout_s", YAML::Node(kDiscoveryServerGsTimeoutS));
+  return for_ds;
+}
+
+GsFileConfig LaunchApp::read_gs_config() const {
+  try {
+    return load_gs_config(cl_.scenario);
+  } catch (const ConfigError& e) {
+    throw ConfigError(explain_scenario_error(e.what(), derived_path(), origin_));
+  }
+}
+
+std::string LaunchApp::derived_path() const {
+  return cl_.scenario == user_scenario_ ? "" : cl_.scenario;
+}
+
+std::vector<std::string> LaunchApp::server_args() const {
+  std::vector<std::string> a = {bin_ + "/ddswarm-sim", "--scenario", cl_.scenario, "--drones",
+                                std::to_string(n_)};
+  if (cl_.mode) {
+    a.push_back("--mode");
+    a.push_back(*cl_.mode);
+  }
+  if (cl_.seed) {
+    a.push_back("--seed");
+    a.push_back(std::to_string(*cl_.seed));
+  }
+  a.insert(a.end(), dds_args_.begin(), dds_args_.end());
+  return a;
+}
+
+std::vector<ChildSpec> LaunchApp::agent_specs() const {
+  // Agent hosts: K processes, each flying a contiguous share of the ids.
+  std::vector<ChildSpec> specs;
+  const auto shares = agent_host_shares(ids_, cl_.agent_hosts);
+  for (std::size_t h = 0; h < shares.size(); ++h)
+    specs.push_back({"agent host " + std::to_string(h), agent_args(shares[h], true)});
+  for (int id : cl_.agent_hosts > 0 ? std::vector<int>{} : ids_) {
+    auto a = agent_args(std::to_string(id), false);
+    if (const int pid = agent_participant_id(n_, id); pid >= 0) {
+      a.push_back("--participant-id");
+      a.push_back(std::to_string(pid));
+    }
+    specs.push_back({"agent " + std::to_string(id), a});
+  }
+  return specs;
+}
+
+void LaunchApp::check_readers() const {
+  // The server and one agent as they will start (the others differ in their
+  // id alone, which this launcher checked); the ground station's reader ran
+  // in read_gs_config. Every section of the scenario has one of the three
+  // as its reader (common/scenario.cpp, check_sections).
+  std::vector<ChildSpec> checks;
+  if (cl_.only != "agents") checks.push_back({"sim check", server_args()});
+  if (const auto agents = agent_specs(); !agents.empty()) checks.push_back(agents.front());
+  for (auto& c : checks) c.argv.push_back("--check");
+  const std::string error = first_check_error(checks);
+  if (!error.empty()) throw ConfigError(explain_scenario_error(error, derived_path(), origin_));
+}
+
+std::string LaunchApp::check_summary() const {
+  std::string with;
+  for (const auto& text : cl_.sets) with += (with.empty() ? " with --set " : ", --set ") + text;
+  std::vector<std::string> readers;
+  if (cl_.only != "agents") readers.push_back("the server");
+  if (!ids_.empty())
+    readers.push_back(cl_.agent_hosts > 0
+                          ? fmt::format("{} agent host(s) of {} drones",
+                                        std::min<int>(cl_.agent_hosts, ids_.size()), ids_.size())
+                          : fmt::format("{} agent(s)", ids_.size()));
+  readers.push_back("the ground station");
+  std::string as;
+  for (std::size_t i = 0; i < readers.size(); ++i)
+    as += (i == 0 ? "" : i + 1 == readers.size() ? " and " : ", ") + readers[i];
+  return fmt::format("ddswarm-launch: ok: {}{} is valid as {} will read it ({} drones)",
+                     user_scenario_, with, as, n_);
 }
 
 int LaunchApp::run() {
+  if (cl_.check) {
+    std::cout << check_summary() << std::endl;
+    return 0;
+  }
+  if (stopping()) return 0;  // a signal while the scenario was checked: nothing started
   death_policy_.emplace(parse_on_death(cl_.on_death));
   procs_.emplace(cl_.gs_interactive && cl_.log_dir.empty() ? "ddswarm-logs" : cl_.log_dir);
-  // What discovery scales with is participants: with agent hosts, a few.
-  const int participants = cl_.agent_hosts > 0 ? std::min<int>(cl_.agent_hosts, n_) + 1 : n_;
-  // Not under DDS Security: Fast DDS 2.9's discovery server has none.
-  if (wants_local_discovery_server(ds_, participants, whole_swarm_,
-                                   localhost_discovery_ && !dds_.secure()))
-    start_discovery_server();
+  if (start_ds_) start_discovery_server();
   if (!cl_.record_dir.empty()) start_recorder();
   if (cl_.only != "agents") start_server();
   warn_about_participant_ids();
@@ -224,34 +385,8 @@ void LaunchApp::start_discovery_server() {
   procs_->start(ds_spec);
   death_policy_->always_restart(ds_spec);  // on the same port: the address its clients were given
   procs_->rejoin_dropped_participants("discovery-server");
-  // A longer lease for the swarm's own participants, unless the scenario
-  // names one: under a 128-process bring-up the discovery server, short of
-  // CPU, drops datagrams, and at the default 3 s it lets the server's lease
-  // lapse and loses it for good (docs/performance.md).
-  // And ground stations patient enough for their own re-join through it
-  // (ground_station/subcommands.cpp: after 20 s without a server), which also
-  // carries them over a restart of the discovery server (docs/faults.md).
-  // And no shared-memory transport, unless the scenario names it: a
-  // sender opening a peer's port waits a third of dds.shm_health_check_s
-  // (3.3 s) whenever the port's idle listener was just checked, with
-  // every send of its participant held. In 128-process bring-ups the
-  // server stalls 10-20 s that way and loses up to 119 of 128 agents;
-  // over UDP (the swarm state still by data-sharing) it does not
-  // (docs/dds.md).
-  const YAML::Node root = YamlDocument::load_file(cl_.scenario).root();
-  std::map<std::string, YAML::Node> for_ds;
-  auto unless_named = [&](const char* section, const char* key, const YAML::Node& value) {
-    if (!(root[section] && root[section][key])) for_ds[fmt::format("{}.{}", section, key)] = value;
-  };
-  unless_named("dds", "lease_duration_s", YAML::Node(kDiscoveryServerLeaseS));
-  unless_named("dds", "shm_transport", YAML::Node(false));
-  unless_named("ground_station", "discovery_timeout_s", YAML::Node(kDiscoveryServerGsTimeoutS));
-  if (!for_ds.empty()) {
-    std::string why;
-    for (const auto& [key, value] : for_ds)
-      why += fmt::format("{}{}: {}", why.empty() ? "" : ", ", key, value.as<std::string>());
-    derive(for_ds, why + " (a discovery server)");
-  }
+  // Its overrides of the scenario were written and checked before anything
+  // started (discovery_server_overrides).
   const std::string address = "127.0.0.1:" + std::to_string(port);
   dds_args_.push_back("--discovery-server");
   dds_args_.push_back(address);
@@ -270,20 +405,7 @@ void LaunchApp::start_recorder() {
   wait_for_stop(std::chrono::milliseconds(500));
 }
 
-void LaunchApp::start_server() {
-  std::vector<std::string> a = {bin_ + "/ddswarm-sim", "--scenario", cl_.scenario, "--drones",
-                                std::to_string(n_)};
-  if (cl_.mode) {
-    a.push_back("--mode");
-    a.push_back(*cl_.mode);
-  }
-  if (cl_.seed) {
-    a.push_back("--seed");
-    a.push_back(std::to_string(*cl_.seed));
-  }
-  a.insert(a.end(), dds_args_.begin(), dds_args_.end());
-  procs_->start({"sim", a});
-}
+void LaunchApp::start_server() { procs_->start({"sim", server_args()}); }
 
 void LaunchApp::warn_about_participant_ids() {
   if (cl_.agent_hosts == 0 && !ids_.empty() && agent_participant_id(n_, ids_.back()) < 0 &&
@@ -309,21 +431,9 @@ std::vector<std::string> LaunchApp::agent_args(const std::string& agent_ids, boo
 }
 
 void LaunchApp::start_agents() {
-  // Agent hosts: K processes, each flying a contiguous share of the ids.
-  const auto shares = agent_host_shares(ids_, cl_.agent_hosts);
-  const auto start_agent = [&](const ChildSpec& spec) {
+  for (const auto& spec : agent_specs()) {
     procs_->start(spec);
     death_policy_->restartable(spec);  // what --on-death restart may start again
-  };
-  for (std::size_t h = 0; h < shares.size(); ++h)
-    start_agent({"agent host " + std::to_string(h), agent_args(shares[h], true)});
-  for (int id : cl_.agent_hosts > 0 ? std::vector<int>{} : ids_) {
-    auto a = agent_args(std::to_string(id), false);
-    if (const int pid = agent_participant_id(n_, id); pid >= 0) {
-      a.push_back("--participant-id");
-      a.push_back(std::to_string(pid));
-    }
-    start_agent({"agent " + std::to_string(id), a});
   }
 }
 

@@ -16,6 +16,8 @@
 
 #include "common/dds_config.hpp"
 #include "common/domain_claim.hpp"
+#include "common/scenario_check.hpp"
+#include "ground_station/gs_app.hpp"
 #include "launcher/launcher.hpp"
 
 namespace ddswarm::gs {
@@ -28,6 +30,7 @@ struct LaunchCommandLine {
   std::optional<std::uint64_t> seed;
   double duration_s = 0;
   bool gs_interactive = false;
+  bool check = false;  ///< --check: check the scenario, start nothing
   int agent_hosts = 0;
   std::string record_dir;
   std::vector<std::string> sets;
@@ -46,27 +49,65 @@ std::vector<std::string> split_script(const std::string& s);
 /// back as a new participant (agent.rejoin_after_s, common/agent_rejoin.hpp).
 double agents_wait_s(const std::string& scenario);
 
+/// A file removed when this goes (a launch's scenario copy outside its log
+/// directory): at a normal end, at an error, and after SIGINT or SIGTERM,
+/// which end ddswarm-launch through its normal end.
+class RemovedAtExit {
+ public:
+  RemovedAtExit() = default;
+  RemovedAtExit(const RemovedAtExit&) = delete;
+  RemovedAtExit& operator=(const RemovedAtExit&) = delete;
+  ~RemovedAtExit();
+  void set(std::string path) { path_ = std::move(path); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 class LaunchApp {
  public:
-  /// Checks the parsed command line, writes the run's scenario when --set
-  /// overrides it, and claims the domain when it runs a server. Starts
-  /// nothing. Throws FieldError/ConfigError naming what is wrong.
+  /// Checks the parsed command line; writes the run's scenario when --set
+  /// (or the discovery server it starts) overrides it; checks that scenario
+  /// as every process the launch starts will read it (ddswarm-sim --check,
+  /// ddswarm-agent --check, and the ground station's reader); and claims the
+  /// domain when it runs a server (not with --check). Starts nothing. Throws
+  /// FieldError/ConfigError naming what is wrong as the user typed it: the
+  /// --set flag, or the scenario file and its line.
   LaunchApp(const CLI::App& app, LaunchCommandLine cl);
   LaunchApp(const LaunchApp&) = delete;
   LaunchApp& operator=(const LaunchApp&) = delete;
 
   /// Starts every process, runs --gs or the console or waits, then stops
   /// them all. Returns the exit code: 1 when a process died (policy
-  /// permitting) or a --gs step failed.
+  /// permitting) or a --gs step failed. With --check, prints the one-line
+  /// summary of the check the constructor passed and returns 0.
   int run();
+  /// The one line --check prints: what was checked, as whom.
+  std::string check_summary() const;
+  /// The scenario every process reads: the user's, or its copy with the overrides.
+  const std::string& scenario() const { return cl_.scenario; }
   /// Ends run() from any thread as SIGINT would (the processes are stopped).
   void stop() { stop_ = true; }
   /// A stop was asked for: stop() or a signal (stop_requested()).
   bool stopping() const;
 
  private:
-  /// Derives the run's scenario with overrides; every process then reads the same file.
-  void derive(const std::map<std::string, YAML::Node>& overrides, const std::string& why);
+  /// Writes the run's scenario, the user's with overrides (why says which);
+  /// every process then reads that file.
+  void derive(const YAML::Node& scenario, const std::string& why);
+  /// What a discovery server the launch starts changes in the scenario
+  /// (root: the scenario with --set), unless the scenario names it.
+  std::map<std::string, YAML::Node> discovery_server_overrides(const YAML::Node& root) const;
+  /// The ground station's reading of the run's scenario; errors in the user's terms.
+  GsFileConfig read_gs_config() const;
+  /// The run's scenario when it is a copy of the user's; "" when it is theirs.
+  std::string derived_path() const;
+  /// Runs --check of the server and of the first agent as they will start.
+  void check_readers() const;
+  std::vector<std::string> server_args() const;
+  /// The arguments of each agent process (or agent host) the launch starts.
+  std::vector<ChildSpec> agent_specs() const;
   void start_discovery_server();
   void start_recorder();
   void start_server();
@@ -82,8 +123,13 @@ class LaunchApp {
   int run_foreground(const std::vector<std::string>& argv);
 
   LaunchCommandLine cl_;
-  DdsConfig file_dds_;  ///< the scenario's dds section alone
-  DdsConfig dds_;       ///< the swarm's domain and network: the file, then the flags
+  std::string user_scenario_;  ///< the scenario file the user named
+  ScenarioOrigin origin_;      ///< what was written into its copy, to name it in errors
+  RemovedAtExit copy_;         ///< the copy, when it is not in the log directory
+  std::string why_;            ///< what the copy changes ("" when there is none)
+  bool start_ds_ = false;      ///< the launch starts a discovery server
+  DdsConfig file_dds_;         ///< the scenario's dds section alone
+  DdsConfig dds_;              ///< the swarm's domain and network: the file, then the flags
   std::optional<DomainClaim> claim_;
   int n_ = 0;
   std::vector<int> ids_;

@@ -18,8 +18,10 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
       return app.exit(e) == 0 ? 0 : 2;
     }
-    gs::LaunchApp launch(app, std::move(cl));
+    // Before the scenario's copy is written: SIGINT or SIGTERM while it is
+    // checked end the launch through its normal end, which removes the copy.
     install_stop_signals();
+    gs::LaunchApp launch(app, std::move(cl));
     return launch.run();
   });
   return end_process(code);

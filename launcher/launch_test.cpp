@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -56,6 +57,31 @@ TEST(LaunchApp, RefusesWhatItCannotStartBeforeStartingAnything) {
   EXPECT_THROW(build({kScenario, "--only", "agents", "--drones", "0"}), FieldError);
   EXPECT_THROW(build({kScenario, "--only", "agents", "--ids", "9"}), FieldError);  // 6 drones
   EXPECT_THROW(build({kScenario, "--only", "agents", "--discovery-server", "nowhere"}), FieldError);
+}
+
+TEST(LaunchApp, ABadSetIsNamedAndItsCopyRemovedBeforeAnythingStarts) {
+  const auto dir = temp_dir("tmp");
+  const char* tmpdir = std::getenv("TMPDIR");
+  const std::string old_tmpdir = tmpdir ? tmpdir : "";
+  setenv("TMPDIR", dir.c_str(), 1);
+  try {
+    build({kScenario, "--only", "agents", "--set", "agent.inter_distance_m=-1"});
+    ADD_FAILURE() << "a launch with a bad --set was built";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "--set agent.inter_distance_m=-1: must be > 0");
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir)) << "the scenario's copy was left behind";
+  {
+    auto launch = build({kScenario, "--only", "agents", "--set", "agent.inter_distance_m=3"});
+    EXPECT_EQ(std::filesystem::path(launch->scenario()).parent_path(), dir);
+    EXPECT_TRUE(std::filesystem::exists(launch->scenario()));
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir)) << "the scenario's copy outlived the launch";
+  if (old_tmpdir.empty())
+    unsetenv("TMPDIR");
+  else
+    setenv("TMPDIR", old_tmpdir.c_str(), 1);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(LaunchApp, StopEndsTheRunAndStopsItsProcesses) {

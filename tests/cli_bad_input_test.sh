@@ -39,9 +39,9 @@ expect_usage_error "gs experiment --set without =" "--set = sim.physics_rate_hz:
   gs experiment "$SRC/config/table1.yaml" --out "$WORK/exp" --set sim.physics_rate_hz
 # A bad value in an experiment's set is found before any run, in well under a second, not after
 # each run's wait for a swarm whose server exited at once (4 runs would take 4 minutes).
-expect_usage_error "gs experiment --set a bad rate" "set 'Slow': ddswarm-sim: error: $WORK/exp-bad/runs/Slow-00.yaml:8: sim.control_rate_hz = 70: must divide" \
+expect_usage_error "gs experiment --set a bad rate" "ddswarm-gs: error: --set sim.control_rate_hz=70: must divide physics_rate_hz (1000)" \
   gs experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$WORK/exp-bad" --set sim.control_rate_hz=70
-expect_usage_error "gs experiment --set an unknown agent key" "set 'Slow': ddswarm-agent: error:" \
+expect_usage_error "gs experiment --set an unknown agent key" "ddswarm-gs: error: --set agent.no_such_key=1: unknown key" \
   gs experiment "$SRC/tests/scenarios/short_experiment.yaml" --out "$WORK/exp-bad" --set agent.no_such_key=1
 [ ! -e "$WORK/exp-bad/short.csv" ] || problems+=("experiment with a bad set ran runs anyway")
 # A bad DDSWARM_FASTDDS_LOG (docs/dds.md) is named, before any DDS wait.
