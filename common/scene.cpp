@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <random>
 
@@ -58,6 +59,21 @@ void load(YamlSection s, SceneConfig& c) {
   FieldLoader load(s);
   SceneConfig::fields(c, load);
   s.finish();
+}
+
+void anchor_mesh_files(YAML::Node& root, const std::string& scenario_dir) {
+  if (!root.IsMap() || !root["scene"] || !root["scene"].IsMap()) return;
+  YAML::Node meshes = root["scene"]["meshes"];
+  if (!meshes || !meshes.IsSequence()) return;
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    YAML::Node m = meshes[i];
+    if (!m.IsMap() || !m["file"] || !m["file"].IsScalar()) continue;
+    const std::filesystem::path file = m["file"].Scalar();
+    if (file.empty() || file.is_absolute()) continue;
+    m["file"] = std::filesystem::absolute(std::filesystem::path(scenario_dir) / file)
+                    .lexically_normal()
+                    .string();
+  }
 }
 
 void SceneConfig::validate() const {

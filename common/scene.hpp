@@ -173,4 +173,10 @@ struct SceneConfig {
 
 void load(YamlSection s, SceneConfig& c);
 
+/// Makes every relative scene.meshes[].file of a scenario document absolute,
+/// against scenario_dir (the folder of the file it was read from), so a copy
+/// written elsewhere (ddswarm-launch --set, an experiment's runs) names the
+/// same mesh files. Leaves anything it does not recognise as it is.
+void anchor_mesh_files(YAML::Node& root, const std::string& scenario_dir);
+
 }  // namespace ddswarm

@@ -19,6 +19,7 @@
 #include "common/process.hpp"
 #include "common/scenario.hpp"
 #include "common/scenario_overrides.hpp"
+#include "common/scene.hpp"
 #include "ground_station/gs_app.hpp"
 
 namespace ddswarm::gs {
@@ -181,6 +182,7 @@ bool LaunchApp::stopping() const { return stop_ || stop_requested(); }
 
 void LaunchApp::derive(const std::map<std::string, YAML::Node>& overrides, const std::string& why) {
   YAML::Node derived = apply_overrides(YamlDocument::load_file(cl_.scenario).root(), overrides);
+  anchor_mesh_files(derived, std::filesystem::path(cl_.scenario).parent_path().string());
   const std::string dir =
       cl_.log_dir.empty() ? std::filesystem::temp_directory_path().string() : cl_.log_dir;
   std::filesystem::create_directories(dir);
