@@ -31,7 +31,7 @@ try {
     const body = Buffer.from(await res.arrayBuffer());
     check(res.status === 200 && body.equals(fs.readFileSync(files[i])), `GET ${m.url} answers ${files[i]}'s ${body.length} bytes`);
   }
-  for (const p of ['/mesh/0000000000000000.obj', '/mesh/%2e%2e/index.html', '/mesh/']) {
+  for (const p of ['/mesh/0000000000000000.obj', '/mesh/town.obj', '/mesh/meshes%2Ftown.obj', '/mesh/']) {
     const res = await fetch(new URL(p, a.url));
     check(res.status === 404, `GET ${p} is 404 (got ${res.status})`);
   }
@@ -53,8 +53,15 @@ try {
   const text = await page.textContent('#s-wind');
   check(text.includes('3.0 m/s toward 90°') && text.includes('turbulence') && text.includes('gusts 2/min'), `the panel says the wind: '${text}'`);
 
-  await page.evaluate(() => window.ddswarm.setCamera?.('orbit'));
-  await page.waitForTimeout(500);
+  // The view from above the start, the bridge and the town ahead; once the page draws.
+  await waitFor(page, () => window.ddswarm.fps > 0, null, { timeout: 60000, what: 'the render loop' });
+  await page.evaluate(() => {
+    const w = window.ddswarm._internals.world;
+    w.camera.position.set(-22, -18, 26);
+    w.controls.target.set(0, 34, 0);
+    w.controls.update();
+  });
+  await page.waitForTimeout(1500);
   const shot = path.join(out, 'web_view_mesh_world.png');
   await page.screenshot({ path: shot });
   console.log(`screenshot: ${shot}`);
