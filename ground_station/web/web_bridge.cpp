@@ -359,16 +359,13 @@ struct WebBridge::Impl {
     std::shared_ptr<const msg::SwarmState> state;
     std::vector<msg::CollisionEvent> events;
     std::uint64_t skipped = 0;
+    std::shared_ptr<const msg::Scene> new_scene;
     {
       std::lock_guard<std::mutex> lock(latest.mu);
       state = latest.state;
       if (latest.scene_ver != cache.scene_ver) {
         cache.scene_ver = latest.scene_ver;
-        auto s = text(encode_scene(*latest.scene, meshes.offer(*latest.scene)));
-        if (!cache.scene || *cache.scene != *s) {
-          cache.scene = s;
-          ++cache.scene_content;
-        }
+        new_scene = latest.scene;
       }
       if (latest.status_ver != cache.status_ver) {
         cache.status_ver = latest.status_ver;
@@ -388,6 +385,15 @@ struct WebBridge::Impl {
         events.push_back(latest.collisions[s - first]);
       c.collision_seen = latest.collision_seq;
     }
+    // Outside the lock the DDS callbacks take: offer() may read mesh files.
+    if (new_scene) {
+      auto s = text(encode_scene(*new_scene, meshes.offer(*new_scene)));
+      if (!cache.scene || *cache.scene != *s) {
+        cache.scene = s;
+        ++cache.scene_content;
+      }
+    }
+
     const double now = wall_seconds();
     if (cache.scene && c.scene_sent != cache.scene_content) {
       c.scene_sent = cache.scene_content;
