@@ -71,6 +71,22 @@ TEST_F(MeshFiles, AnStlWallIsItsFacets) {
   EXPECT_EQ(hi, Eigen::Vector3f(4, 0, 3));
 }
 
+// One triangle in a glTF file, its buffer inline, under a node raised 5 m.
+const char* kRaisedTriangleGltf = R"({"asset": {"version": "2.0"}, "scene": 0,
+  "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "translation": [0, 0, 5]}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+  "buffers": [{"byteLength": 36,
+    "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]}]})";
+
+TEST_F(MeshFiles, AGltfTriangleKeepsItsNodesTransform) {
+  const TriangleMesh m = read_mesh_file(write("raised.gltf", kRaisedTriangleGltf));
+  ASSERT_EQ(m.triangles.size(), 1u);
+  for (const auto& v : m.vertices) EXPECT_EQ(v.z(), 5.0f);
+}
+
 TEST_F(MeshFiles, EachBadFileNamesItsReason) {
   EXPECT_EQ(reason(dir_ / "absent.obj"), "no such file");
   EXPECT_EQ(reason(write("empty.obj", "")), "the file is empty");
