@@ -23,8 +23,9 @@ export class WindLayer {
     }
     this.points = null;
     const w = wind ?? {};
-    const steady = new THREE.Vector3(...(w.steady ?? [0, 0, 0]));
-    const sigma = w.sigma ?? [0, 0, 0];
+    const finite = (a) => [0, 1, 2].map((k) => (Number.isFinite(a?.[k]) ? a[k] : 0));  // null: unknown
+    const steady = new THREE.Vector3(...finite(w.steady));
+    const sigma = finite(w.sigma);
     const speed = steady.length();
     const calm = speed === 0 && !w.turbulence && !(w.gusts_per_minute > 0);
     this.info = { speed, arrows: 0, particles: 0, turbulence: !!w.turbulence, sigma, gusts_per_minute: w.gusts_per_minute ?? 0 };
