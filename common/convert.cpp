@@ -75,6 +75,19 @@ SceneConfig from_msg(const msg::Scene& s) {
     c.cylinders.push_back({Eigen::Vector2d(cy.x(), cy.y()), cy.radius_m(), cy.height_m()});
   for (const auto& b : s.boxes())
     c.boxes.push_back({from_msg(b.center()), from_msg(b.size()), b.yaw_rad()});
+  for (const auto& m : s.meshes()) {
+    MeshObstacle o;
+    o.file = m.file().to_string();
+    o.position = from_msg(m.position());
+    o.rotation_deg = from_msg(m.rotation_deg());
+    o.yaw_deg = m.yaw_deg();
+    o.scale = m.scale();
+    o.bounds_min = from_msg(m.bounds_min());
+    o.bounds_max = from_msg(m.bounds_max());
+    o.triangle_count = m.triangle_count();
+    o.content_hash = m.content_hash();
+    c.meshes.push_back(std::move(o));
+  }
   c.bounds_min = from_msg(s.bounds_min());
   c.bounds_max = from_msg(s.bounds_max());
   c.finish_a = from_msg(s.finish_a()).head<2>();
@@ -101,6 +114,19 @@ msg::Scene to_msg(const SceneConfig& c) {
     m.size(to_msg(b.size));
     m.yaw_rad(b.yaw_rad);
     s.boxes().push_back(m);
+  }
+  for (const auto& o : c.meshes) {
+    msg::Mesh m;
+    m.file(o.file.substr(0, 255));
+    m.position(to_msg(o.position));
+    m.rotation_deg(to_msg(o.rotation_deg));
+    m.yaw_deg(o.yaw_deg);
+    m.scale(o.scale);
+    m.bounds_min(to_msg(o.bounds_min));
+    m.bounds_max(to_msg(o.bounds_max));
+    m.triangle_count(o.triangle_count);
+    m.content_hash(o.content_hash);
+    s.meshes().push_back(m);
   }
   s.bounds_min(to_msg(c.bounds_min));
   s.bounds_max(to_msg(c.bounds_max));

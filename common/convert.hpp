@@ -40,7 +40,8 @@ msg::MissionCommand to_msg(const MissionCommand& c);
 
 msg::MissionAck to_msg(const MissionAck& a, std::uint64_t issuer_instance);
 
-/// The world a Scene sample carries: ground, obstacles, bounds, finish line,
+/// The world a Scene sample carries: ground, obstacles (meshes as entries,
+/// their triangle counts, bounds and file hashes, not their triangles), bounds, finish line,
 /// goal and the start formation's centre (the rest of StartConfig is the
 /// server's, and start_positions carries where the drones stand).
 SceneConfig from_msg(const msg::Scene& s);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 using namespace ddswarm;
 
 TEST(Convert, ASceneKeepsItsWorldThroughTheWire) {
@@ -9,6 +11,17 @@ TEST(Convert, ASceneKeepsItsWorldThroughTheWire) {
   c.ground_z_m = -0.5;
   c.cylinders = {{{3, -4}, 0.6, 9}, {{-12.5, 40}, 1.25, 15}};
   c.boxes = {{{5, 6, 1.5}, {2, 3, 3}, 0.4}};
+  MeshObstacle m;
+  m.file = "meshes/town.obj";
+  m.position = {4, 30, 0};
+  m.rotation_deg = {90, 0, 5};
+  m.yaw_deg = -30;
+  m.scale = 0.01;
+  m.bounds_min = {-6, 24, 0};
+  m.bounds_max = {14, 38, 12.5};
+  m.triangle_count = 372;
+  m.content_hash = 0xfeedfacecafebeefULL;
+  c.meshes = {m};
   c.bounds_min = {-80, -20, -0.5};
   c.bounds_max = {90, 120, 30};
   c.finish_a = {-40, 55};
@@ -27,6 +40,17 @@ TEST(Convert, ASceneKeepsItsWorldThroughTheWire) {
   EXPECT_EQ(back.boxes[0].center, c.boxes[0].center);
   EXPECT_EQ(back.boxes[0].size, c.boxes[0].size);
   EXPECT_EQ(back.boxes[0].yaw_rad, c.boxes[0].yaw_rad);
+  ASSERT_EQ(back.meshes.size(), 1u);
+  EXPECT_EQ(back.meshes[0].file, m.file);
+  EXPECT_EQ(back.meshes[0].position, m.position);
+  EXPECT_EQ(back.meshes[0].rotation_deg, m.rotation_deg);
+  EXPECT_EQ(back.meshes[0].yaw_deg, m.yaw_deg);
+  EXPECT_EQ(back.meshes[0].scale, m.scale);
+  EXPECT_EQ(back.meshes[0].bounds_min, m.bounds_min);
+  EXPECT_EQ(back.meshes[0].bounds_max, m.bounds_max);
+  EXPECT_EQ(back.meshes[0].triangle_count, m.triangle_count);
+  EXPECT_EQ(back.meshes[0].content_hash, m.content_hash);
+  EXPECT_FALSE(back.meshes[0].world);  // the triangles stay with the server
   EXPECT_EQ(back.bounds_min, c.bounds_min);
   EXPECT_EQ(back.bounds_max, c.bounds_max);
   EXPECT_EQ(back.finish_a, c.finish_a);
@@ -37,6 +61,40 @@ TEST(Convert, ASceneKeepsItsWorldThroughTheWire) {
   // What the wire leaves to the server stays unset.
   EXPECT_TRUE(to_msg(c).name().to_string().empty());
   EXPECT_EQ(to_msg(c).num_drones(), 0);
+}
+
+// A hostile or broken Scene sample's mesh is refused by the checks every
+// receiver runs on a Scene (SceneConfig::validate on from_msg).
+TEST(Convert, AHostileMeshInASceneSampleIsRefused) {
+  SceneConfig c;
+  MeshObstacle m;
+  m.file = "meshes/town.obj";
+  m.bounds_min = {0, 0, 0};
+  m.bounds_max = {1, 1, 1};
+  m.triangle_count = 12;
+  c.meshes = {m};
+  EXPECT_NO_THROW(from_msg(to_msg(c)).validate());
+  const auto refused = [&](auto&& spoil, const std::string& field) {
+    msg::Scene s = to_msg(c);
+    spoil(s.meshes()[0]);
+    try {
+      from_msg(s).validate();
+    } catch (const FieldError& e) {
+      EXPECT_EQ(e.field(), field);
+      return;
+    }
+    ADD_FAILURE() << field << " accepted";
+  };
+  const double nan = std::nan("");
+  refused([&](msg::Mesh& x) { x.scale(0); }, "scene.meshes[0].scale");
+  refused([&](msg::Mesh& x) { x.scale(nan); }, "scene.meshes[0].scale");
+  refused([&](msg::Mesh& x) { x.position().y(nan); }, "scene.meshes[0].position");
+  refused([&](msg::Mesh& x) { x.rotation_deg().x(INFINITY); }, "scene.meshes[0].rotation_deg");
+  refused([&](msg::Mesh& x) { x.yaw_deg(nan); }, "scene.meshes[0].yaw_deg");
+  refused([&](msg::Mesh& x) { x.file(""); }, "scene.meshes[0].file");
+  refused([&](msg::Mesh& x) { x.file("a\nb.obj"); }, "scene.meshes[0].file");
+  refused([&](msg::Mesh& x) { x.bounds_max().z(-1); }, "scene.meshes[0].bounds_max");
+  refused([&](msg::Mesh& x) { x.bounds_min().x(nan); }, "scene.meshes[0].bounds_max");
 }
 
 TEST(Convert, AMissionCommandAndItsAckKeepEveryField) {

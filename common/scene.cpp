@@ -3,15 +3,77 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <random>
 
 namespace ddswarm {
+namespace {
+
+bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
+
+/// Squared distance from p to triangle (a, b, c): the closest-point regions
+/// of Ericson, Real-Time Collision Detection (2005), sec. 5.1.5.
+double distance2_to_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                             const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - ab * (d1 / (d1 - d3))).squaredNorm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - ac * (d2 / (d2 - d6))).squaredNorm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (bp - (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))).squaredNorm();
+  const double denom = 1.0 / (va + vb + vc);
+  return (ap - ab * (vb * denom) - ac * (vc * denom)).squaredNorm();
+}
+
+/// Distance from p to an axis-aligned box (0 inside).
+double distance_to_aabb(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
+                        const Eigen::Vector3d& hi) {
+  return (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
+}
+
+}  // namespace
+
+Eigen::Matrix3d MeshObstacle::rotation() const {
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  const auto about = [](double deg, const Eigen::Vector3d& axis) {
+    return Eigen::AngleAxisd(deg * kDeg, axis).toRotationMatrix();
+  };
+  return about(yaw_deg, Eigen::Vector3d::UnitZ()) *
+         about(rotation_deg.z(), Eigen::Vector3d::UnitZ()) *
+         about(rotation_deg.y(), Eigen::Vector3d::UnitY()) *
+         about(rotation_deg.x(), Eigen::Vector3d::UnitX());
+}
 
 void load(YamlSection s, SceneConfig& c) {
   FieldLoader load(s);
   SceneConfig::fields(c, load);
   s.finish();
+}
+
+void anchor_mesh_files(YAML::Node& root, const std::string& scenario_dir) {
+  if (!root.IsMap() || !root["scene"] || !root["scene"].IsMap()) return;
+  YAML::Node meshes = root["scene"]["meshes"];
+  if (!meshes || !meshes.IsSequence()) return;
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    YAML::Node m = meshes[i];
+    if (!m.IsMap() || !m["file"] || !m["file"].IsScalar()) continue;
+    const std::filesystem::path file = m["file"].Scalar();
+    if (file.empty() || file.is_absolute()) continue;
+    m["file"] = std::filesystem::absolute(std::filesystem::path(scenario_dir) / file)
+                    .lexically_normal()
+                    .string();
+  }
 }
 
 void SceneConfig::validate() const {
@@ -21,6 +83,28 @@ void SceneConfig::validate() const {
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     std::string p = "scene.boxes[" + std::to_string(i) + "]";
     for (int k = 0; k < 3; ++k) check_positive(p + ".size", boxes[i].size[k]);
+  }
+  if (meshes.size() > 64)
+    throw FieldError("scene.meshes", std::to_string(meshes.size()) + " entries", "at most 64");
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const MeshObstacle& m = meshes[i];
+    const std::string p = "scene.meshes[" + std::to_string(i) + "]";
+    if (m.file.empty()) throw FieldError(p + ".file", "\"\"", "must name a mesh file");
+    if (m.file.size() > 255)
+      throw FieldError(p + ".file", m.file.substr(0, 40) + "...", "must be at most 255 characters");
+    for (unsigned char ch : m.file)
+      if (ch < 0x20 || ch == 0x7f)
+        throw FieldError(p + ".file", one_line(m.file), "must not hold control characters");
+    if (!finite(m.position))
+      throw FieldError(p + ".position", to_text(m.position.transpose()), "must be finite");
+    if (!finite(m.rotation_deg))
+      throw FieldError(p + ".rotation_deg", to_text(m.rotation_deg.transpose()), "must be finite");
+    if (!std::isfinite(m.yaw_deg))
+      throw FieldError(p + ".yaw_deg", to_text(m.yaw_deg), "must be finite");
+    if (m.triangle_count > 0 && !(finite(m.bounds_min) && finite(m.bounds_max) &&
+                                  (m.bounds_min.array() <= m.bounds_max.array()).all()))
+      throw FieldError(p + ".bounds_max", to_text(m.bounds_max.transpose()),
+                       "must be finite and at least bounds_min on every axis");
   }
   for (int k = 0; k < 3; ++k)
     if (!(bounds_max[k] > bounds_min[k]))
@@ -71,6 +155,21 @@ double SceneConfig::clearance(const Eigen::Vector3d& p) const {
     double outside = q.cwiseMax(0.0).norm();
     double inside = std::min(std::max(q.x(), std::max(q.y(), q.z())), 0.0);
     best = std::min(best, outside + inside);
+  }
+  for (const auto& m : meshes) {
+    if (m.triangle_count == 0) continue;
+    const double to_bounds = distance_to_aabb(p, m.bounds_min, m.bounds_max);
+    if (!m.world) {
+      best = std::min(best, to_bounds);
+      continue;
+    }
+    if (to_bounds >= best) continue;  // no triangle can be nearer than the bounds
+    double d2 = best * best;
+    const auto& v = m.world->vertices;
+    for (const auto& t : m.world->triangles)
+      d2 = std::min(d2, distance2_to_triangle(p, v[t[0]].cast<double>(), v[t[1]].cast<double>(),
+                                              v[t[2]].cast<double>()));
+    best = std::min(best, std::sqrt(d2));
   }
   return best;
 }

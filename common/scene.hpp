@@ -5,7 +5,9 @@
 // Loaded from the scenario's `scene:` section by the server, published on the
 // transient-local Scene topic, and read back from there by every other process.
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,46 @@ struct Box {
   }
 };
 
+/// Triangles in the world frame (m, ENU), as the server simulates a mesh.
+struct TriangleMesh {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;  ///< indices into vertices
+};
+
+/// A static obstacle made of a mesh file's triangles (OBJ, STL, glTF),
+/// scaled, then rotated (rotation_deg: roll about x, pitch about y, yaw
+/// about z, applied in that order, then yaw_deg about z), then moved to
+/// position. The file is read by the server only (common/mesh_loader.hpp);
+/// the Scene carries the entry and what loading found, never the triangles.
+struct MeshObstacle {
+  std::string file;  ///< relative to the scenario file's folder (or absolute)
+  Eigen::Vector3d position{0, 0, 0};
+  double yaw_deg = 0.0;
+  Eigen::Vector3d rotation_deg{0, 0, 0};
+  double scale = 1.0;
+
+  // What loading the file found (or what a Scene sample says it found).
+  std::uint32_t triangle_count = 0;                          ///< 0 until loaded
+  std::uint64_t content_hash = 0;                            ///< FNV-1a 64 of the file's bytes
+  Eigen::Vector3d bounds_min{0, 0, 0}, bounds_max{0, 0, 0};  ///< m, world AABB of the triangles
+  /// The triangles in the world frame: the server's only (null from the wire).
+  std::shared_ptr<const TriangleMesh> world;
+
+  /// World from file coordinates, without the scale: Rz(yaw_deg) Rz Ry Rx.
+  Eigen::Matrix3d rotation() const;
+
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.field("file", c.file,
+            {"", any(), "an .obj, .stl, .gltf or .glb file, relative to the scenario file"});
+    v.field("position", c.position, {"m", any(), "where the file's origin goes"});
+    v.field("yaw_deg", c.yaw_deg, {"deg", any(), "rotation about +z, after rotation_deg"});
+    v.field("rotation_deg", c.rotation_deg,
+            {"deg", any(), "[roll, pitch, yaw] about x, y, z (e.g. [90, 0, 0]: a y-up file)"});
+    v.field("scale", c.scale, {"", positive(), "multiplies the file's coordinates (to metres)"});
+  }
+};
+
 enum class Formation { kCluster, kGrid, kRandom, kExplicit };
 
 /// Where drones start. kCluster packs drones on a hexagonal lattice around
@@ -67,6 +109,8 @@ struct SceneConfig {
   double ground_z_m = 0.0;
   std::vector<Cylinder> cylinders;
   std::vector<Box> boxes;
+  /// Mesh obstacles; their triangles once the server loads them (load_meshes).
+  std::vector<MeshObstacle> meshes;
   Eigen::Vector3d bounds_min{-100, -100, 0};
   Eigen::Vector3d bounds_max{100, 100, 50};
   Eigen::Vector2d finish_a{-50, 60};
@@ -87,6 +131,8 @@ struct SceneConfig {
     v.field("ground_z_m", c.ground_z_m, {"m", any(), "height of the ground plane"});
     v.list("cylinders", c.cylinders, "vertical pillars standing on the ground");
     v.list("boxes", c.boxes, "boxes");
+    v.list("meshes", c.meshes,
+           "static obstacles from mesh files: file, position, yaw_deg, rotation_deg, scale");
     v.field("bounds_min", c.bounds_min,
             {"m", any(), "world bounds: leaving them is flagged, not prevented"});
     v.field("bounds_max", c.bounds_max,
@@ -116,7 +162,9 @@ struct SceneConfig {
   /// True when p is on the goal's side of the finish line.
   bool past_finish(const Eigen::Vector2d& p) const;
   /// Horizontal clearance from p (at height z) to the nearest obstacle surface
-  /// (negative inside); +inf when there are no obstacles.
+  /// (negative inside); +inf when there are no obstacles. A mesh counts with
+  /// the distance from p to its nearest triangle (a surface has no inside),
+  /// or to its bounds when its triangles are not loaded (from the wire).
   double clearance(const Eigen::Vector3d& p) const;
   /// Start positions for n drones (z = ground). Throws FieldError if they do
   /// not fit (overlap an obstacle, or explicit list shorter than n).
@@ -124,5 +172,11 @@ struct SceneConfig {
 };
 
 void load(YamlSection s, SceneConfig& c);
+
+/// Makes every relative scene.meshes[].file of a scenario document absolute,
+/// against scenario_dir (the folder of the file it was read from), so a copy
+/// written elsewhere (ddswarm-launch --set, an experiment's runs) names the
+/// same mesh files. Leaves anything it does not recognise as it is.
+void anchor_mesh_files(YAML::Node& root, const std::string& scenario_dir);
 
 }  // namespace ddswarm

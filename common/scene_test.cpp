@@ -56,3 +56,19 @@ TEST(Reference, TheScenarioAndSceneSectionsDescribeEveryFieldAsTheCodeDeclaresIt
     if (r.key.rfind("generate.", 0) != 0) scene.push_back(r);
   EXPECT_EQ(reference_mismatches(doc, "### `scene:`", scene), Mismatches{});
 }
+
+// A scenario written elsewhere (ddswarm-launch --set, an experiment's runs)
+// still names the mesh files its original names.
+TEST(Scene, AnchoredMeshFilesAreAbsoluteAgainstTheScenariosFolder) {
+  YAML::Node root = YAML::Load(
+      "scene:\n  meshes:\n    - {file: meshes/town.obj}\n    - {file: /abs/bridge.stl}\n"
+      "    - {file: ../up.stl, scale: 2}\n");
+  anchor_mesh_files(root, "/work/config");
+  EXPECT_EQ(root["scene"]["meshes"][0]["file"].as<std::string>(), "/work/config/meshes/town.obj");
+  EXPECT_EQ(root["scene"]["meshes"][1]["file"].as<std::string>(), "/abs/bridge.stl");
+  EXPECT_EQ(root["scene"]["meshes"][2]["file"].as<std::string>(), "/work/up.stl");
+  EXPECT_EQ(root["scene"]["meshes"][2]["scale"].as<double>(), 2);
+  YAML::Node none = YAML::Load("scene: {cylinders: []}");
+  anchor_mesh_files(none, "/x");
+  EXPECT_FALSE(none["scene"]["meshes"]);
+}

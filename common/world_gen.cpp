@@ -198,7 +198,7 @@ int forest(const ForestConfig& f, Draw& d, SceneConfig& scene, int* wanted) {
                                   d.uniform(f.area_min.y(), f.area_max.y()));
     if (kept_out(scene, c.center_xy, f.keep_out_m + c.radius_m)) continue;
     const Eigen::Vector3d at(c.center_xy.x(), c.center_xy.y(), scene.ground_z_m + 0.5);
-    if (!before.cylinders.empty() || !before.boxes.empty())
+    if (!before.cylinders.empty() || !before.boxes.empty() || !before.meshes.empty())
       if (before.clearance(at) < c.radius_m + f.min_gap_m) continue;
     const auto [ix, iy] = key(c.center_xy);
     bool clear = true;

@@ -18,6 +18,7 @@
 #include "common/domain_claim.hpp"
 #include "common/process.hpp"
 #include "common/scenario_check.hpp"
+#include "common/scene.hpp"
 #include "experiment/report.hpp"
 #include "ground_station/gs_app.hpp"
 #include "launcher/launcher.hpp"
@@ -201,6 +202,7 @@ std::vector<RunPlan> plan_runs(const ExperimentConfig& cfg, const ExperimentOpti
   std::vector<RunPlan> plans;
   for (std::size_t s = 0; s < cfg.sets.size(); ++s) {
     YAML::Node base = scenario_for_set(cfg, s);
+    anchor_mesh_files(base, std::filesystem::path(cfg.scenario_path).parent_path().string());
     for (int k = 0; k < cfg.runs_per_set; ++k) {
       RunPlan p;
       p.set = s;

@@ -179,7 +179,7 @@ int run_gs(CLI::App& app, GsCommandLine& cl) {
     if (!app.get_subcommands().empty())
       throw FieldError("--web", cl.web_addr, "takes no subcommand");
     return serve_web(file, cl.web_addr, cl.web_root, cl.web_remote, cl.web_upload_mb,
-                     cl.web_duration);
+                     cl.web_duration, std::filesystem::path(cl.config).parent_path());
   }
   if (*cl.experiment) return experiment_command(file, cl);
   if (*cl.trace) return trace_command(cl.config, file, cl);
@@ -235,8 +235,10 @@ void append_result(const std::string& csv, const TaskOutcome& o, int drones) {
 }
 
 int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root,
-              bool remote, double upload_mb, double duration_s) {
+              bool remote, double upload_mb, double duration_s,
+              const std::filesystem::path& mesh_dir) {
   web::WebBridgeOptions o;
+  o.mesh_dir = mesh_dir.empty() ? std::filesystem::path(".") : mesh_dir;
   web::parse_listen_address(addr, o.server);
   o.server.web_root = root.empty() ? web::default_web_root() : std::filesystem::path(root);
   o.server.allow_remote = remote;

@@ -3,6 +3,7 @@
 // function each, so that main (ground_station/main.cpp) only parses, builds
 // and runs, and a test can run a subcommand in its own process.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -73,9 +74,11 @@ int run_gs(CLI::App& app, GsCommandLine& cl);
 int compare_experiments(const std::vector<std::string>& files, std::vector<std::string> labels,
                         const std::string& plot_dir, bool fail_if_different);
 
-/// `--web`: serves the live view until SIGINT/SIGTERM (docs/web_view.md).
+/// `--web`: serves the live view until SIGINT/SIGTERM (docs/web_view.md);
+/// mesh_dir: what a Scene's relative mesh file names are relative to.
 int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root,
-              bool remote, double upload_mb, double duration_s);
+              bool remote, double upload_mb, double duration_s,
+              const std::filesystem::path& mesh_dir = ".");
 
 /// `ddswarm-gs experiment`.
 int experiment_command(const GsFileConfig& file, const GsCommandLine& cl);

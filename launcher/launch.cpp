@@ -19,6 +19,7 @@
 #include "common/process.hpp"
 #include "common/scenario.hpp"
 #include "common/scenario_overrides.hpp"
+#include "common/scene.hpp"
 #include "ground_station/gs_app.hpp"
 #include "launcher/preflight.hpp"
 
@@ -243,8 +244,11 @@ void LaunchApp::derive(const YAML::Node& scenario, const std::string& why) {
     std::filesystem::create_directories(cl_.log_dir);
     path = cl_.log_dir + "/scenario-" + std::to_string(getpid()) + ".yaml";
   }
+  // Mesh files are named relative to the user's scenario, not to the copy.
+  YAML::Node derived = YAML::Clone(scenario);
+  anchor_mesh_files(derived, std::filesystem::path(user_scenario_).parent_path().string());
   std::ofstream f(path);
-  f << "# " << user_scenario_ << " with " << why << "\n" << YAML::Dump(scenario) << "\n";
+  f << "# " << user_scenario_ << " with " << why << "\n" << YAML::Dump(derived) << "\n";
   if (!f) throw std::runtime_error("cannot write " + path);
   cl_.scenario = path;
   why_ = why;

@@ -21,8 +21,9 @@ void CollisionCounts::add(const ContactEvent& e) {
 msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim,
                          const SceneConfig& scene, const QuadrotorParams& quadrotor,
                          const SensorConfig& sensors, const std::vector<Eigen::Vector3d>& starts,
-                         std::uint64_t server_instance) {
+                         std::uint64_t server_instance, const WindConfig& wind) {
   msg::Scene s = to_msg(scene);
+  s.wind(scene_wind(wind));
   s.name(scenario.name.substr(0, 127));
   s.seed(scenario.seed);
   s.server_instance(server_instance);
@@ -36,6 +37,20 @@ msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim,
   s.sensor_count(static_cast<std::uint16_t>(sensors.count));
   s.sensor_max_range_m(static_cast<float>(sensors.max_range_m));
   return s;
+}
+
+msg::SceneWind scene_wind(const WindConfig& wind) {
+  msg::SceneWind w;
+  w.steady_mps(to_msg(wind.steady_mps));
+  w.turbulence(wind.turbulence);
+  if (wind.turbulence) {
+    const DrydenScales d = dryden_scales(wind.steady_mps.norm(), wind.turbulence_altitude_m);
+    w.turbulence_sigma_mps(
+        to_msg(wind.turbulence_scale * Eigen::Vector3d(d.sigma_u, d.sigma_v, d.sigma_w)));
+  }
+  w.gusts_per_minute(wind.gusts_per_minute);
+  w.gust_max_mps(wind.gusts_per_minute > 0 ? wind.gust_amplitude_mps.y() : 0.0);
+  return w;
 }
 
 msg::SwarmState swarm_state_frame(int n, const SensorConfig& sensors) {

@@ -23,6 +23,7 @@
 #include "sim_server/quadrotor.hpp"
 #include "sim_server/sim_config.hpp"
 #include "sim_server/task_referee.hpp"
+#include "sim_server/wind.hpp"
 
 namespace ddswarm::sim {
 
@@ -41,7 +42,11 @@ struct CollisionCounts {
 msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim,
                          const SceneConfig& scene, const QuadrotorParams& quadrotor,
                          const SensorConfig& sensors, const std::vector<Eigen::Vector3d>& starts,
-                         std::uint64_t server_instance);
+                         std::uint64_t server_instance, const WindConfig& wind = {});
+
+/// The wind as a Scene tells viewers of it: the mean, turbulence's
+/// intensities (Dryden, at the model's altitude), the gusts' rate and size.
+msg::SceneWind scene_wind(const WindConfig& wind);
 
 /// A SwarmState for n drones with what never changes filled in: each scan's
 /// drone id, max range and ray angles (rad, body frame, +CCW).

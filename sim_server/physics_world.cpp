@@ -112,6 +112,24 @@ double ray_box(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::
   return t0;
 }
 
+/// The nearest triangle a ray crosses, either face.
+struct NearestTriangle final : btTriangleRaycastCallback {
+  using btTriangleRaycastCallback::btTriangleRaycastCallback;
+  btScalar reportHit(const btVector3&, btScalar fraction, int, int) override {
+    return m_hitFraction = std::min(m_hitFraction, fraction);
+  }
+};
+
+/// Distance along a unit ray to a triangle mesh whose vertices are in the
+/// world frame, within [0, t_max]; kInf if none.
+double ray_mesh(btBvhTriangleMeshShape& mesh, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                double t_max) {
+  const btVector3 from = to_bt(o), to = to_bt(o + d * t_max);
+  NearestTriangle cb(from, to);
+  mesh.performRaycast(&cb, from, to);
+  return cb.m_hitFraction < 1 ? cb.m_hitFraction * t_max : kInf;
+}
+
 /// Distance along a unit ray to the half-space z <= ground_z.
 double ray_ground(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double ground_z,
                   double t_max) {
@@ -295,6 +313,26 @@ PhysicsWorld::PhysicsWorld(const SceneConfig& scene, const QuadrotorParams& q,
         {b.center, b.size / 2, std::cos(b.yaw_rad), std::sin(b.yaw_rad), true});
     add_static(std::make_unique<btBoxShape>(to_bt(b.size / 2)), b.center, b.yaw_rad,
                ContactKind::kObstacle, index++);
+  }
+  for (const MeshObstacle& m : scene.meshes) {
+    if (!m.world || m.world->triangles.empty()) {
+      // Nothing to collide with, but the indices stay the Scene's.
+      obstacle_shapes_.push_back(
+          {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 1.0, 0.0, false, nullptr});
+      ++index;
+      continue;
+    }
+    auto tm = std::make_unique<btTriangleMesh>(true, false);
+    const auto& v = m.world->vertices;
+    for (const auto& t : m.world->triangles)
+      tm->addTriangle(btVector3(v[t[0]].x(), v[t[0]].y(), v[t[0]].z()),
+                      btVector3(v[t[1]].x(), v[t[1]].y(), v[t[1]].z()),
+                      btVector3(v[t[2]].x(), v[t[2]].y(), v[t[2]].z()), false);
+    auto shape = std::make_unique<btBvhTriangleMeshShape>(tm.get(), true);
+    obstacle_shapes_.push_back({(m.bounds_min + m.bounds_max) / 2,
+                                (m.bounds_max - m.bounds_min) / 2, 1.0, 0.0, false, shape.get()});
+    triangle_meshes_.push_back(std::move(tm));
+    add_static(std::move(shape), Eigen::Vector3d::Zero(), 0.0, ContactKind::kObstacle, index++);
   }
 
   drone_shape_ = std::make_unique<btCylinderShapeZ>(to_bt(
@@ -550,6 +588,7 @@ double PhysicsWorld::ray_distance(const RayTarget& t, const Eigen::Vector3d& o,
                           params_.collision_radius_m, params_.collision_half_height_m, t_max);
   }
   const ObstacleShape& s = obstacle_shapes_[t.index];
+  if (s.mesh) return ray_mesh(*s.mesh, o, d, t_max);
   const Eigen::Vector3d r = o - s.center;
   if (!s.box) return ray_cylinder_z(r, d, s.half.x(), s.half.z(), t_max);
   // Into the box frame: rotate by -yaw.

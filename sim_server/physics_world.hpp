@@ -21,6 +21,8 @@ class btDiscreteDynamicsWorld;
 class btCollisionObject;
 class btCollisionShape;
 class btRigidBody;
+class btTriangleMesh;
+class btBvhTriangleMeshShape;
 
 namespace ddswarm::sim {
 
@@ -31,14 +33,16 @@ struct ContactEvent {
   int drone = 0;  ///< drone id (for drone-drone contacts, the lower id)
   ContactKind kind = ContactKind::kGround;
   /// kDrone: the other (higher) drone id; kObstacle: obstacle index, scene
-  /// cylinders first, then boxes (cylinders.size() + box index); kGround: -1.
+  /// cylinders first, then boxes (cylinders.size() + box index), then meshes
+  /// (cylinders.size() + boxes.size() + mesh index); kGround: -1.
   int other = -1;
   Eigen::Vector3d where_world{0, 0, 0};  ///< m, a contact point, ENU
 };
 
 /// How cast_rays finds what a ray hits. kCulled and kBruteForce intersect
 /// rays analytically with the exact shapes (ground plane, cylinders, boxes,
-/// drone cylinders at full attitude) and give identical ranges; kCulled asks
+/// drone cylinders at full attitude; a mesh's triangles through its Bullet
+/// bounding-volume tree, both faces) and give identical ranges; kCulled asks
 /// Bullet's broadphase for what lies within range first and tests a ray only
 /// against objects whose bounding box it crosses.
 enum class RayCastMode : std::uint8_t {
@@ -59,8 +63,10 @@ enum class BulletPath : std::uint8_t { kShortcuts, kStock };
 
 class PhysicsWorld {
  public:
-  /// Builds the ground plane at scene.ground_z_m, the scene's cylinders and
-  /// boxes, and one drone per start position, resting on the ground: the
+  /// Builds the ground plane at scene.ground_z_m, the scene's cylinders,
+  /// boxes and meshes (static triangle meshes, btBvhTriangleMeshShape, of
+  /// each mesh's world triangles; a mesh without them, as from the wire, is
+  /// left out), and one drone per start position, resting on the ground: the
   /// bottom of its collision cylinder at start_positions[i] (whose z is
   /// normally the ground height), level, heading start_yaw_rad. Contacts that
   /// exist at construction (drones resting on the ground) are not reported.
@@ -157,9 +163,10 @@ class PhysicsWorld {
   /// Exact geometry of an obstacle, for ray casts.
   struct ObstacleShape {
     Eigen::Vector3d center;
-    Eigen::Vector3d half;  ///< cylinder: (r, r, h/2); box: half sizes
+    Eigen::Vector3d half;  ///< cylinder: (r, r, h/2); box: half sizes; mesh: half its bounds
     double cos_yaw, sin_yaw;
     bool box;
+    btBvhTriangleMeshShape* mesh = nullptr;  ///< a mesh's triangles (world frame)
   };
   /// A drone or obstacle a ray may hit, with its exact AABB.
   struct RayTarget {
@@ -191,9 +198,11 @@ class PhysicsWorld {
   std::unique_ptr<btDbvtBroadphase> broadphase_;
   std::unique_ptr<btSequentialImpulseConstraintSolver> solver_;
   std::unique_ptr<btDiscreteDynamicsWorld> world_;
-  std::vector<std::unique_ptr<btCollisionShape>> static_shapes_;  ///< ground, cylinders, boxes
-  std::unique_ptr<btCollisionShape> drone_shape_;                 ///< shared by all drones
-  std::vector<std::unique_ptr<btRigidBody>> statics_;             ///< ground, then obstacles
+  std::vector<std::unique_ptr<btTriangleMesh>> triangle_meshes_;  ///< outlive their shapes
+  std::vector<std::unique_ptr<btCollisionShape>>
+      static_shapes_;                                  ///< ground, cylinders, boxes, meshes
+  std::unique_ptr<btCollisionShape> drone_shape_;      ///< shared by all drones
+  std::vector<std::unique_ptr<btRigidBody>> statics_;  ///< ground, then obstacles
   std::vector<Drone> drones_;
   std::vector<ObstacleShape> obstacle_shapes_;  ///< by obstacle index
 

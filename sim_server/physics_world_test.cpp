@@ -24,6 +24,25 @@ SceneConfig scene_with(std::vector<Cylinder> cylinders, std::vector<Box> boxes =
   return s;
 }
 
+/// A mesh obstacle as the server holds it once loaded: a wall of two
+/// triangles in the plane x = x0, from y = -half_y to half_y, z = 0 to height.
+MeshObstacle mesh_wall(double x0, double half_y, double height) {
+  auto t = std::make_shared<TriangleMesh>();
+  const auto f = [](double x, double y, double z) {
+    return Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+  };
+  t->vertices = {f(x0, -half_y, 0), f(x0, half_y, 0), f(x0, half_y, height),
+                 f(x0, -half_y, height)};
+  t->triangles = {{0, 1, 2}, {0, 2, 3}};
+  MeshObstacle m;
+  m.file = "wall.obj";
+  m.triangle_count = 2;
+  m.bounds_min = {x0, -half_y, 0};
+  m.bounds_max = {x0, half_y, height};
+  m.world = t;
+  return m;
+}
+
 void step_for(PhysicsWorld& w, double seconds, double dt = kDt) {
   const int n = static_cast<int>(std::lround(seconds / dt));
   for (int i = 0; i < n; ++i) w.step(dt);
@@ -298,6 +317,38 @@ TEST(RaySensors, MeasureTheDistanceToRotatedBoxes) {
   EXPECT_EQ(hit[0], 1);
 }
 
+TEST(RaySensors, MeasureTheDistanceToAMeshWallFromEitherSide) {
+  SceneConfig scene;
+  scene.meshes = {mesh_wall(3, 5, 4)};
+  PhysicsWorld w(scene, QuadrotorParams{}, {{0, 0, 0}}, 0.0);
+  w.reset_drone(0, {0, 0, 1}, 0.0);
+  std::mt19937_64 rng(1);
+  std::vector<float> range;
+  std::vector<std::uint8_t> hit;
+  SensorConfig c = exact_sensors();
+  c.max_range_m = 10;
+  for (auto mode : {RayCastMode::kCulled, RayCastMode::kBruteForce, RayCastMode::kWorldRayTest}) {
+    w.set_ray_cast_mode(mode);
+    w.cast_rays(0, c, rng, range, hit);
+    EXPECT_EQ(hit[0], 1);
+    EXPECT_NEAR(range[0], 3.0, 1e-4);  // east, square on
+    EXPECT_EQ(hit[1], 1);
+    EXPECT_NEAR(range[1], 3.0 * std::sqrt(2.0), 1e-4);  // north-east, 45 degrees on
+    EXPECT_EQ(hit[4], 0);                               // west: nothing
+    EXPECT_EQ(hit[2], 0);                               // north: along the wall's plane
+  }
+  // From behind, the triangles' other face.
+  w.set_ray_cast_mode(RayCastMode::kCulled);
+  w.reset_drone(0, {5, 0, 1}, kPi);
+  w.cast_rays(0, c, rng, range, hit);
+  EXPECT_EQ(hit[0], 1);
+  EXPECT_NEAR(range[0], 2.0, 1e-4);
+  // Above the wall's top, the rays pass over it.
+  w.reset_drone(0, {0, 0, 5}, 0.0);
+  w.cast_rays(0, c, rng, range, hit);
+  EXPECT_EQ(hit[0], 0);
+}
+
 TEST(RaySensors, RotateWithTheBody) {
   PhysicsWorld w(scene_with({Cylinder{{2, 0}, 0.5, 6}}), QuadrotorParams{}, {{0, 0, 0}}, 0.0);
   w.reset_drone(0, {0, 0, 1}, kPi / 2);  // facing +y: the pillar is on the right
@@ -503,6 +554,28 @@ TEST(Contacts, BoxesAreNumberedAfterCylinders) {
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].kind, ContactKind::kObstacle);
   EXPECT_EQ(events[0].other, 2);
+}
+
+TEST(Contacts, FlyingIntoAMeshWallIsOneEventNumberedAfterTheBoxes) {
+  // Obstacles: a pillar (0) and a box (1) out of the way, a mesh that is only
+  // an entry (2, as from the wire: nothing to hit), the mesh wall (3).
+  SceneConfig scene = scene_with({Cylinder{{-10, 0}, 0.5, 5}}, {Box{{-10, 8, 1}, {1, 1, 2}, 0}});
+  MeshObstacle entry = mesh_wall(-20, 1, 1);
+  entry.world.reset();
+  scene.meshes = {entry, mesh_wall(3, 5, 4)};
+  Swarm s(scene, {{0, 0, 0}});
+  s.take_off(1.0);
+  EXPECT_TRUE(s.world.take_contact_events().empty());
+  s.sp[0].v_world = {1, 0, 0};
+  s.run(5.0);
+  const auto events = s.world.take_contact_events();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, ContactKind::kObstacle);
+  EXPECT_EQ(events[0].other, 3);
+  EXPECT_NEAR(events[0].where_world.x(), 3.0, 0.05);
+  const double r = QuadrotorParams{}.collision_radius_m;
+  EXPECT_GT(s.world.state(0).p_world.x(), 3.0 - r - 0.1);  // stopped by the wall,
+  EXPECT_LT(s.world.state(0).p_world.x(), 3.0);            // not through it
 }
 
 TEST(Contacts, TwoDronesPushedTogetherAreOneEvent) {

@@ -1,6 +1,9 @@
 // ServerConfig: what the server reads from a scenario file, and its checks.
 #include "sim_server/sim_server.hpp"
 
+#include <filesystem>
+
+#include "common/mesh_loader.hpp"
 #include "common/world_gen.hpp"
 
 namespace ddswarm::sim {
@@ -37,6 +40,8 @@ ServerConfig load_server_config(const std::string& path) {
     load(doc.section("aero"), c.aero);
     load(doc.section("dds"), c.dds);
     c.scene.validate();
+    // Mesh files are read by the server alone, relative to the scenario file.
+    load_meshes(c.scene, std::filesystem::path(path).parent_path());
     // The server generates the world once, before anything is placed in it;
     // every other process receives it in the Scene.
     if (c.scene.generate.enabled())

@@ -164,7 +164,7 @@ struct SimServer::Impl {
 
   void publish_scene() {
     const msg::Scene s = scene_message(cfg.scenario, cfg.sim, cfg.scene, cfg.quadrotor, cfg.sensors,
-                                       starts, instance);
+                                       starts, instance, cfg.wind);
     {
       std::lock_guard<std::mutex> lock(in.mu);
       in.arbiter.published(std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -394,6 +394,12 @@ struct SimServer::Impl {
         cfg.sim.physics_rate_hz, cfg.sim.control_rate_hz, cfg.scenario.seed);
     if (!cfg.generated_world.empty())
       spdlog::info("ddswarm-sim: generated world: {}", cfg.generated_world);
+    if (!cfg.scene.meshes.empty()) {
+      std::size_t triangles = 0;
+      for (const auto& m : cfg.scene.meshes) triangles += m.triangle_count;
+      spdlog::info("ddswarm-sim: {} mesh obstacle(s), {} triangles", cfg.scene.meshes.size(),
+                   triangles);
+    }
     if (cfg.wind.enabled())
       spdlog::info("ddswarm-sim: wind {:.1f} m/s{}{}", cfg.wind.steady_mps.norm(),
                    cfg.wind.turbulence ? ", Dryden turbulence" : "",

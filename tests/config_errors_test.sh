@@ -60,6 +60,7 @@ done
 
 # Sections only the server reads (agents get the scene from the server over DDS).
 case_ "sim: negative radius" 'bad_negative_radius\.yaml:8:' 'scene\.cylinders\[1\]\.radius_m' '-2\.5' -- run_sim "$S/bad_negative_radius.yaml"
+case_ "sim: missing mesh file" 'bad_mesh_file\.yaml:8:' 'scene\.meshes\[1\]\.file' 'no_such_bridge\.stl' 'no such file' -- run_sim "$S/bad_mesh_file.yaml"
 case_ "sim: rate does not divide" 'bad_rate\.yaml:7:' 'sim\.control_rate_hz' '\b70\b' -- run_sim "$S/bad_rate.yaml"
 case_ "sim: negative sensor range" 'bad_sensor_range\.yaml:7:' 'sensors\.max_range_m' '-6' -- run_sim "$S/bad_sensor_range.yaml"
 case_ "sim: sensor range beyond the world" 'bad_sensor_beyond_world\.yaml:10:' 'sensors\.max_range_m' '\b600\b' "world's size" -- \

@@ -81,6 +81,7 @@ struct WebBridge::Impl {
   } latest;
 
   std::unique_ptr<DdsCommander> commander;
+  MeshFiles meshes;  // before the server, whose thread asks it for files
   std::unique_ptr<WebServer> server;
 
   // ---- the server's thread only ----
@@ -138,7 +139,8 @@ struct WebBridge::Impl {
 
   Participant dds;  // last member: closed first in ~Impl, before what its callbacks touch
 
-  explicit Impl(const WebBridgeOptions& o) : opt(o), dds(o.dds, "ddswarm-gs-web") {
+  explicit Impl(const WebBridgeOptions& o)
+      : opt(o), meshes(o.mesh_dir), dds(o.dds, "ddswarm-gs-web") {
     opt.gs.validate();
     opt.task.validate();
     commander = std::make_unique<DdsCommander>(opt.gs, opt.dds);
@@ -152,6 +154,7 @@ struct WebBridge::Impl {
                              std::function<void(int, std::string)> respond) {
       on_upload(f, name, std::move(respond));
     };
+    hooks.on_mesh = [this](std::string_view path) { return meshes.find(path); };
     server = std::make_unique<WebServer>(opt.server, std::move(hooks));
     subscribe();
     worker = std::thread([this] { work(); });
@@ -290,7 +293,7 @@ struct WebBridge::Impl {
     c.last_wall = wall_seconds();
     seek(c);
     c.peer->send(text(encode_hello("replay", opt.gs.name)));
-    if (c.rec->scene) c.peer->send(text(encode_scene(*c.rec->scene)));
+    if (c.rec->scene) c.peer->send(text(encode_scene(*c.rec->scene, meshes.offer(*c.rec->scene))));
     send_replay_info(c);
     on_tick(c.peer);
   }
@@ -356,16 +359,13 @@ struct WebBridge::Impl {
     std::shared_ptr<const msg::SwarmState> state;
     std::vector<msg::CollisionEvent> events;
     std::uint64_t skipped = 0;
+    std::shared_ptr<const msg::Scene> new_scene;
     {
       std::lock_guard<std::mutex> lock(latest.mu);
       state = latest.state;
       if (latest.scene_ver != cache.scene_ver) {
         cache.scene_ver = latest.scene_ver;
-        auto s = text(encode_scene(*latest.scene));
-        if (!cache.scene || *cache.scene != *s) {
-          cache.scene = s;
-          ++cache.scene_content;
-        }
+        new_scene = latest.scene;
       }
       if (latest.status_ver != cache.status_ver) {
         cache.status_ver = latest.status_ver;
@@ -385,6 +385,15 @@ struct WebBridge::Impl {
         events.push_back(latest.collisions[s - first]);
       c.collision_seen = latest.collision_seq;
     }
+    // Outside the lock the DDS callbacks take: offer() may read mesh files.
+    if (new_scene) {
+      auto s = text(encode_scene(*new_scene, meshes.offer(*new_scene)));
+      if (!cache.scene || *cache.scene != *s) {
+        cache.scene = s;
+        ++cache.scene_content;
+      }
+    }
+
     const double now = wall_seconds();
     if (cache.scene && c.scene_sent != cache.scene_content) {
       c.scene_sent = cache.scene_content;

@@ -8,6 +8,7 @@
 // nothing. Commands from the pages run one at a time on a worker thread
 // through DdsCommander, exactly as the CLI sends them.
 #include <cstdint>
+#include <filesystem>
 #include <iosfwd>
 #include <memory>
 #include <string>
@@ -24,6 +25,9 @@ struct WebBridgeOptions {
   TaskConfig task;  ///< defaults for the task command
   DdsConfig dds;
   double duration_s = 0;  ///< s wall; 0 = until SIGINT/SIGTERM
+  /// What a Scene's relative mesh file names are relative to: the folder of
+  /// the ground station's --config (the server's are relative to its scenario's).
+  std::filesystem::path mesh_dir = ".";
 };
 
 /// What the bridge did, for its closing line and the tests.

@@ -212,9 +212,26 @@ std::string encode_hello(std::string_view source, std::string_view gs_name) {
       {{"type", "hello"}, {"version", kProtocolVersion}, {"source", source}, {"gs_name", gs_name}});
 }
 
-std::string encode_scene(const msg::Scene& s) {
+std::string encode_scene(const msg::Scene& s, const std::vector<MeshUrl>& mesh_urls) {
   const SceneConfig world = from_msg(s);
-  json cyl = json::array(), box = json::array();
+  json cyl = json::array(), box = json::array(), meshes = json::array();
+  for (std::size_t i = 0; i < world.meshes.size(); ++i) {
+    const MeshObstacle& m = world.meshes[i];
+    const Eigen::Quaterniond q(m.rotation());
+    const bool served = i < mesh_urls.size() && !mesh_urls[i].url.empty();
+    meshes.push_back({{"file", m.file},
+                      {"url", served ? json(mesh_urls[i].url) : json(nullptr)},
+                      {"why", served                 ? ""
+                              : i < mesh_urls.size() ? mesh_urls[i].why
+                                                     : "not offered"},
+                      {"p", vec(m.position)},
+                      {"q", json::array({q.w(), q.x(), q.y(), q.z()})},
+                      {"scale", m.scale},
+                      {"bounds_min", vec(m.bounds_min)},
+                      {"bounds_max", vec(m.bounds_max)},
+                      {"triangles", m.triangle_count}});
+  }
+  const auto& w = s.wind();
   for (const auto& c : world.cylinders)
     cyl.push_back(
         {{"x", c.center_xy.x()}, {"y", c.center_xy.y()}, {"r", c.radius_m}, {"h", c.height_m}});
@@ -228,6 +245,13 @@ std::string encode_scene(const msg::Scene& s) {
                {"ground_z", world.ground_z_m},
                {"cylinders", std::move(cyl)},
                {"boxes", std::move(box)},
+               {"meshes", std::move(meshes)},
+               {"wind",
+                {{"steady", vec(w.steady_mps())},
+                 {"turbulence", w.turbulence()},
+                 {"sigma", vec(w.turbulence_sigma_mps())},
+                 {"gusts_per_minute", w.gusts_per_minute()},
+                 {"gust_max", w.gust_max_mps()}}},
                {"bounds_min", vec(world.bounds_min)},
                {"bounds_max", vec(world.bounds_max)},
                {"finish_a", vec(world.finish_a)},

@@ -17,6 +17,7 @@
 #include "SimStatus.h"
 #include "SwarmState.h"
 #include "TaskStatus.h"
+#include "ground_station/web/mesh_files.hpp"
 
 namespace ddswarm::gs::web {
 
@@ -57,7 +58,9 @@ std::vector<double> nearest_distances(const std::vector<Eigen::Vector3d>& positi
 std::string encode_frame(const Frame& f, bool rays);
 /// `hello`: source is "live" or "replay".
 std::string encode_hello(std::string_view source, std::string_view gs_name);
-std::string encode_scene(const msg::Scene& s);
+/// `scene`; mesh_urls: where each of s's meshes is served (MeshFiles::offer),
+/// in s's order (missing entries: not served).
+std::string encode_scene(const msg::Scene& s, const std::vector<MeshUrl>& mesh_urls = {});
 std::string encode_status(const msg::SimStatus& s);
 std::string encode_task(const msg::TaskStatus& t);
 /// dropped: collision events this client has missed so far (rate limit).

@@ -2,8 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+
+#include "common/mesh_loader.hpp"
 
 using namespace ddswarm;
 using namespace ddswarm::gs::web;
@@ -345,4 +352,71 @@ TEST(WebParse, HugeAndDeeplyNestedMessages) {
   // Brackets inside strings are text, not nesting.
   EXPECT_EQ(error_of(R"({"type":"live","x":"[[[[[[[[[[[[[[[[[["})").rfind("message nested", 0),
             std::string::npos);
+}
+
+// The meshes a Scene names are served only when this machine has the very
+// file the server loaded; the scene message says where, or why not, and
+// carries the wind.
+TEST(WebFrame, MeshFilesAreServedOnlyWithTheServersBytes) {
+  namespace fs = std::filesystem;
+  const fs::path dir =
+      fs::temp_directory_path() / ("ddswarm_mesh_files_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "meshes");
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir / "meshes" / "a.obj") << obj;
+  std::ofstream(dir / "meshes" / "b.obj") << obj << "\n";  // not the server's bytes
+  msg::Scene sc;
+  const auto add = [&](const std::string& file, std::uint64_t hash) {
+    msg::Mesh m;
+    m.file(file);
+    m.scale(2);
+    m.yaw_deg(90);
+    m.triangle_count(1);
+    m.content_hash(hash);
+    m.bounds_max().x(2);
+    sc.meshes().push_back(m);
+  };
+  const std::uint64_t a_hash = file_hash(dir / "meshes" / "a.obj");
+  add("meshes/a.obj", a_hash);
+  add("meshes/b.obj", a_hash);
+  add("meshes/absent.obj", a_hash);
+  add((dir / "meshes" / "a.obj").string(), a_hash);  // absolute
+  add("meshes/a.ply", a_hash);
+  sc.wind().steady_mps().x(3);
+  sc.wind().turbulence(true);
+  sc.wind().turbulence_sigma_mps().z(0.3);
+  sc.wind().gusts_per_minute(2);
+  sc.wind().gust_max_mps(3);
+
+  MeshFiles files(dir);
+  const auto urls = files.offer(sc);
+  ASSERT_EQ(urls.size(), 5u);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(a_hash));
+  EXPECT_EQ(urls[0].url, std::string("/mesh/") + hex + ".obj");
+  EXPECT_EQ(urls[1].url, "");
+  EXPECT_EQ(urls[1].why, "differs from the server's");
+  EXPECT_EQ(urls[2].why, "no such file here");
+  EXPECT_EQ(urls[3].url, urls[0].url);
+  EXPECT_EQ(urls[4].why, "not a mesh file");
+  EXPECT_EQ(files.find(urls[0].url), dir / "meshes" / "a.obj");
+  EXPECT_FALSE(files.find("/mesh/0000000000000000.obj"));
+  EXPECT_FALSE(files.find("/mesh/../meshes/a.obj"));
+
+  const json j = json::parse(encode_scene(sc, urls));
+  ASSERT_EQ(j["meshes"].size(), 5u);
+  EXPECT_EQ(j["meshes"][0]["url"], urls[0].url);
+  EXPECT_TRUE(j["meshes"][1]["url"].is_null());
+  EXPECT_EQ(j["meshes"][1]["why"], "differs from the server's");
+  EXPECT_EQ(j["meshes"][0]["scale"], 2);
+  EXPECT_EQ(j["meshes"][0]["triangles"], 1);
+  EXPECT_NEAR(j["meshes"][0]["q"][0].get<double>(), std::sqrt(0.5), 1e-12);  // 90 deg about z
+  EXPECT_NEAR(j["meshes"][0]["q"][3].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_EQ(j["meshes"][0]["bounds_max"], json({2, 0, 0}));
+  EXPECT_EQ(j["wind"]["steady"], json({3, 0, 0}));
+  EXPECT_EQ(j["wind"]["turbulence"], true);
+  EXPECT_EQ(j["wind"]["sigma"][2], 0.3);
+  EXPECT_EQ(j["wind"]["gusts_per_minute"], 2);
+  EXPECT_EQ(j["wind"]["gust_max"], 3);
+  fs::remove_all(dir);
 }

@@ -211,6 +211,8 @@ std::string mime_type(const std::filesystem::path& file) {
       {".md", "text/plain; charset=utf-8"},
       {".glb", "model/gltf-binary"},
       {".gltf", "model/gltf+json"},
+      {".obj", "text/plain; charset=utf-8"},
+      {".stl", "model/stl"},
       {".woff2", "font/woff2"},
       {".ktx2", "image/ktx2"},
       {".hdr", "application/octet-stream"},
@@ -449,7 +451,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     if (!header_->is_done()) return error(http::status::bad_request, "unexpected request body");
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return error(http::status::method_not_allowed, "only GET and HEAD");
-    auto file = resolve_static_path(srv_.root, target);
+    auto file = path.rfind("/mesh/", 0) == 0
+                    ? (srv_.hooks.on_mesh ? srv_.hooks.on_mesh(path) : std::nullopt)
+                    : resolve_static_path(srv_.root, target);
     if (!file) return error(http::status::not_found, "not found");
     beast::error_code ec;
     http::file_body::value_type body;

@@ -73,6 +73,9 @@ struct WebHooks {
   std::function<void(const std::filesystem::path& file, const std::string& name,
                      std::function<void(int, std::string)> respond)>
       on_upload;
+  /// A file served besides the page's: the file for a request path under
+  /// "/mesh/" (the bridge's MeshFiles), or nullopt (HTTP 404).
+  std::function<std::optional<std::filesystem::path>(std::string_view path)> on_mesh;
 };
 
 class WebServer {

@@ -219,6 +219,8 @@ window.ddswarm = {
   get tick() { return state.frame?.tick ?? null; },
   get t() { return state.frame?.t ?? null; },
   get scene() { return state.scene; },
+  get meshes() { return world.meshLayer.items.map((m) => ({ ...m })); },
+  get wind() { return { ...world.wind.info }; },
   get status() { return state.status; },
   get task() { return state.task; },
   get replay() { return controls.replay; },

@@ -9,12 +9,27 @@ function setText(el, text) {
   if (el.textContent !== text) el.textContent = text;
 }
 
+// "3.0 m/s toward 90° (east) · turbulence σ 0.6/0.6/0.3 m/s · gusts 2/min ≤ 3 m/s", or "calm".
+export function windText(w) {
+  if (!w) return '–';
+  const [x, y, z] = w.steady ?? [0, 0, 0];
+  const speed = Math.hypot(x, y, z);
+  const parts = [];
+  if (speed > 0) {
+    const bearing = ((Math.atan2(x, y) * 180) / Math.PI + 360) % 360;  // from north, clockwise
+    parts.push(`${speed.toFixed(1)} m/s toward ${bearing.toFixed(0)}°`);
+  }
+  if (w.turbulence) parts.push(`turbulence σ ${(w.sigma ?? []).map((v) => v.toFixed(2)).join('/')} m/s`);
+  if (w.gusts_per_minute > 0) parts.push(`gusts ${w.gusts_per_minute}/min ≤ ${w.gust_max} m/s`);
+  return parts.length ? parts.join(' · ') : 'calm';
+}
+
 export class Panel {
   constructor({ onSelect } = {}) {
     this.el = {
       conn: $('conn'), source: $('source'), scene: $('s-scene'), time: $('s-time'), rtf: $('s-rtf'),
       state: $('s-state'), agents: $('s-agents'), air: $('s-air'), coll: $('s-coll'),
-      task: $('s-task'), timer: $('s-timer'), body: $('d-body'), count: $('d-count'), log: $('log'),
+      task: $('s-task'), wind: $('s-wind'), timer: $('s-timer'), body: $('d-body'), count: $('d-count'), log: $('log'),
     };
     this.rows = [];
     this.onSelect = onSelect;
@@ -38,6 +53,7 @@ export class Panel {
 
   setScene(s) {
     setText(this.el.scene, `${s.name ?? '?'} · seed ${s.seed ?? '?'} · ${s.mode ?? ''}`);
+    setText(this.el.wind, windText(s.wind));
     this.buildTable(s.num_drones ?? 0);
   }
 

@@ -1,10 +1,13 @@
-// The static world: renderer, lights, ground, pillars, boxes, finish line,
-// world bounds and goal, built from the bridge's `scene` message; and the
+// The static world: renderer, lights, ground, pillars, boxes, mesh
+// obstacles, the wind, finish line, world bounds and goal, built from the
+// bridge's `scene` message; and the
 // three camera modes. Coordinates are the simulation's ENU metres as they
 // are (x east, y north, z up): every camera has up = +z except the top-down
 // one, whose screen-up is north.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { MeshLayer } from './meshes.js';
+import { WindLayer } from './wind.js';
 
 // The fragment half of the vertex-lit materials (pillars here, drones in
 // drones.js): the vertex shader computes vLit, this only writes it out.
@@ -117,6 +120,8 @@ export class World {
     this.staticGroup = new THREE.Group();
     scene.add(this.staticGroup);
     this.bounds = new THREE.Box3(new THREE.Vector3(-40, -20, 0), new THREE.Vector3(40, 100, 30));
+    this.meshLayer = new MeshLayer(surface({ color: 0xc8b8a2, roughness: 0.85, side: THREE.DoubleSide }));
+    this.wind = new WindLayer(scene);
 
     new ResizeObserver(() => this.resize()).observe(container);
     this.setQuality(start);
@@ -226,6 +231,10 @@ export class World {
       g.add(mesh);
     }
 
+    // Mesh obstacles (fetched from the bridge) and the wind.
+    this.meshLayer.set(s.meshes, g);
+    this.wind.set(s.wind, this.bounds, z0);
+
     // Finish line: a chequered strip on the ground with a post at each end.
     if (s.finish_a && s.finish_b) {
       const a = new THREE.Vector2(s.finish_a[0], s.finish_a[1]), b = new THREE.Vector2(s.finish_b[0], s.finish_b[1]);
@@ -324,6 +333,7 @@ export class World {
       this.camera.position.add(delta);
     }
     if (this.goalGem) this.goalGem.rotation.z += dt * 0.8;
+    this.wind.update(dt);
     if (this.mode === 'top') this.topControls.update(); else this.controls.update();
   }
 
