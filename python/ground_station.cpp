@@ -245,9 +245,10 @@ class GroundStation {
     return timed(time_s, wait && time_s > 0, timeout, [&] { return live().hold_for(time_s); });
   }
 
-  py::dict distance(double d_int_m) {
+  py::dict distance(double d_int_m, std::optional<double> timeout) {
     check_range("metres", d_int_m, 0.31, 1000.0);
-    return to_python(blocking(command_s(), [&] { return live().set_distance(d_int_m); }));
+    return to_python(
+        blocking(command_timeout(timeout), [&] { return live().set_distance(d_int_m); }));
   }
 
   py::dict land(bool wait, std::optional<double> timeout) {
@@ -262,15 +263,16 @@ class GroundStation {
     return to_python(r);
   }
 
-  py::dict follow(int leader) {
+  py::dict follow(int leader, std::optional<double> timeout) {
     check_range("leader", leader, 0, 1023);
-    return to_python(blocking(command_s(), [&] { return live().follow_leader(leader); }));
+    return to_python(
+        blocking(command_timeout(timeout), [&] { return live().follow_leader(leader); }));
   }
 
-  py::dict teleop(double north, double east, double up) {
+  py::dict teleop(double north, double east, double up, std::optional<double> timeout) {
     check_speed("north", north), check_speed("east", east), check_speed("up", up);
-    return to_python(
-        blocking(command_s(), [&] { return live().teleop(Eigen::Vector3d(east, north, up)); }));
+    return to_python(blocking(command_timeout(timeout),
+                              [&] { return live().teleop(Eigen::Vector3d(east, north, up)); }));
   }
 
   /// {"command": ..., "outcome": ... (when waited for)}.
@@ -334,6 +336,10 @@ class GroundStation {
 
   /// A command's bound: every agent's acknowledgement, with its one retry.
   double command_s() const { return file_.gs.ack_timeout_s + 5; }
+  double command_timeout(std::optional<double> timeout) const {
+    if (timeout) check_range("timeout", *timeout, 0.0, 86400.0);
+    return timeout.value_or(command_s());
+  }
 
   /// Our child pid has ended (left unreaped for its owner to collect).
   static bool waitpid_gone(int pid) {
@@ -459,10 +465,11 @@ void bind_ground_station(py::module_& m) {
       .def("move", &GroundStation::move, py::arg("north"), py::arg("east"), py::arg("up"),
            py::arg("time"), py::arg("wait"), py::arg("timeout"))
       .def("hold", &GroundStation::hold, py::arg("time"), py::arg("wait"), py::arg("timeout"))
-      .def("distance", &GroundStation::distance, py::arg("metres"))
+      .def("distance", &GroundStation::distance, py::arg("metres"), py::arg("timeout"))
       .def("land", &GroundStation::land, py::arg("wait"), py::arg("timeout"))
-      .def("follow", &GroundStation::follow, py::arg("leader"))
-      .def("teleop", &GroundStation::teleop, py::arg("north"), py::arg("east"), py::arg("up"))
+      .def("follow", &GroundStation::follow, py::arg("leader"), py::arg("timeout"))
+      .def("teleop", &GroundStation::teleop, py::arg("north"), py::arg("east"), py::arg("up"),
+           py::arg("timeout"))
       .def("task", &GroundStation::task, py::arg("speed"), py::arg("epsilon"), py::arg("wait"),
            py::arg("timeout"), py::arg("progress"))
       .def("status", &GroundStation::status, py::arg("timeout"))

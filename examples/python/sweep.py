@@ -28,6 +28,7 @@ p.add_argument("--out", default="sweep.png")
 a = p.parse_args()
 
 out = a.results or tempfile.mkdtemp(prefix="ddswarm-sweep-")
+os.makedirs(out, exist_ok=True)
 exp = os.path.join(out, "sweep.yaml")
 with open(exp, "w") as f:
     f.write(f"experiment:\n  name: sweep\n  scenario: {os.path.abspath(a.scenario)}\n"

@@ -118,9 +118,9 @@ class GroundStation:
         return _ack(self._gs.move(float(north), float(east), float(up), float(time), bool(wait),
                                   timeout))
 
-    def distance(self, metres):
+    def distance(self, metres, timeout=None):
         """Change the wanted inter-drone distance D_int (m, in [0.31, 1000])."""
-        return _ack(self._gs.distance(float(metres)))
+        return _ack(self._gs.distance(float(metres), timeout))
 
     set_distance = distance
 
@@ -132,13 +132,13 @@ class GroundStation:
         """Stop mission motion and swarm in place (for `time` sim s; with wait, until it passed)."""
         return _ack(self._gs.hold(float(time), bool(wait), timeout))
 
-    def follow(self, leader):
+    def follow(self, leader, timeout=None):
         """Drone `leader` flies by teleop(); the others swarm around it."""
-        return _ack(self._gs.follow(int(leader)))
+        return _ack(self._gs.follow(int(leader), timeout))
 
-    def teleop(self, north=0.0, east=0.0, up=0.0):
+    def teleop(self, north=0.0, east=0.0, up=0.0, timeout=None):
         """The leader's velocity (m/s) while following."""
-        return _ack(self._gs.teleop(float(north), float(east), float(up)))
+        return _ack(self._gs.teleop(float(north), float(east), float(up), timeout))
 
     def task(self, speed=None, epsilon=None, wait=True, takeoff=False, timeout=None,
              progress=None):

@@ -4,6 +4,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 
 import numpy as np
@@ -47,14 +48,29 @@ def test_fly_look_and_stop():
         assert after.t >= s.t + 3
         assert after.positions[:, 1].mean() - y0 > 1.5  # flew north
         # Lockstep pauses the clock while the swarm is idle: hold for a time.
-        gs.hold(time=5)
+        gs.hold(time=60)
         ticks = [x.tick for x in gs.states(hz=20, count=3)]
         assert ticks == sorted(set(ticks))
-        # A wait longer than its timeout: TimeoutError, and the swarm carries on.
+        assert gs.distance(4.5).message.startswith("distance 3/3 acknowledged")
+        # A wait longer than its timeout: TimeoutError, and the swarm carries
+        # on. The GIL is free meanwhile: another thread runs.
+        stamps, done = [], threading.Event()
+
+        def tick_along():
+            while not done.is_set():
+                stamps.append(time.monotonic())
+                time.sleep(0.005)
+
+        worker = threading.Thread(target=tick_along)
+        worker.start()
         t0 = time.monotonic()
-        with pytest.raises(TimeoutError):
+        with pytest.raises(TimeoutError, match="did not pass within 0.5 s"):
             gs.hold(time=80000, wait=True, timeout=0.5)
-        assert time.monotonic() - t0 < 3
+        t1 = time.monotonic()
+        done.set()
+        worker.join()
+        assert t1 - t0 < 3
+        assert sum(t0 + 0.05 < t < t1 - 0.05 for t in stamps) >= 5, (t1 - t0, len(stamps))
         assert gs.land(wait=True).ok
         with pytest.raises(ValueError, match="north = 99: must be in"):
             gs.move(north=99, time=1)
