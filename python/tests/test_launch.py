@@ -32,6 +32,9 @@ def test_fly_look_and_stop():
         assert len(swarm.processes()) >= 5
         st = gs.status()
         assert st.live_agents == 3 and st.drones_total == 3 and "lockstep" in st.mode
+        # A second ground station attaches to it by its domain, as from another terminal.
+        with ddswarm.GroundStation(SCENARIO, domain=swarm.domain) as other:
+            assert other.status().live_agents == 3
         # A move before take-off: every drone rejects it, and says why.
         with pytest.raises(ddswarm.CommandError, match="rejected by 0: not airborne") as e:
             gs.move(north=1, time=1)
