@@ -17,9 +17,14 @@ namespace ddswarm::gs {
 
 /// The swarm's answer to one command.
 struct CommandResult {
-  bool ok = false;      ///< every addressed drone accepted
-  std::string message;  ///< e.g. "6/6 acknowledged", "no ack from drones 3, 5",
-                        ///< "rejected by 2: not airborne"
+  CommandResult() = default;
+  CommandResult(bool accepted, std::string line) : ok(accepted), message(std::move(line)) {}
+
+  bool ok = false;           ///< every addressed drone accepted
+  std::string message;       ///< e.g. "6/6 acknowledged", "no ack from drones 3, 5",
+                             ///< "rejected by 2: not airborne"
+  std::vector<int> missing;  ///< drones that did not answer, for callers that name them
+  std::vector<std::pair<int, std::string>> rejected;  ///< drone and its reason, per rejection
 };
 
 /// A snapshot of the swarm for the console's status line.

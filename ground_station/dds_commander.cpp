@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -86,6 +87,21 @@ struct DdsCommander::Impl {
   std::optional<TaskOutcome> outcome;
   Reader<msg::SwarmState>* state_reader = nullptr;  // made by the first swarm_snapshot()
   std::optional<msg::SwarmState> state;             // the latest, once state_reader exists
+  std::atomic<bool> interrupted{false};             // set_interrupted()
+
+  /// A stop was requested: a signal, or set_interrupted(true).
+  bool stopped() const { return stop_requested() || interrupted; }
+
+  /// The swarm state's reader, made on first use.
+  void ensure_state_reader() {
+    if (state_reader) return;
+    state_reader =
+        &dds.reader<msg::SwarmState>([this](const msg::SwarmState& s, const fdds::SampleInfo&) {
+          std::lock_guard<std::mutex> lock(mu);
+          state = s;
+          cv.notify_all();
+        });
+  }
 
   // DDS callbacks touch the members below: stop them before anything is destroyed.
   ~Impl() { dds.close(); }
@@ -179,12 +195,12 @@ struct DdsCommander::Impl {
     std::unique_lock<std::mutex> lock(mu);
     // A signal handler cannot notify cv, and with no server nothing else
     // does: look at the stop flag (Ctrl-C) every 100 ms.
-    while (!stop_requested() && !done()) {
+    while (!stopped() && !done()) {
       const auto now = steady_clock::now();
       if (now >= end) return false;
       cv.wait_for(lock, std::min<steady_clock::duration>(end - now, milliseconds(100)));
     }
-    return !stop_requested();
+    return !stopped();
   }
 
   /// The task status is latched: once our reader has matched the server's
@@ -244,7 +260,7 @@ struct DdsCommander::Impl {
     auto relayed = [&](int id) { return accepted_by(id, s); };
     auto answered = [&](int id) { return acks[s].count(id) > 0 || relayed(id); };
     auto all_in = [&] {
-      if (stop_requested()) return true;
+      if (stopped()) return true;
       for (int id : expect)
         if (!answered(id)) return false;
       if (c.target < 0)  // an agent heard only now must answer too
@@ -266,7 +282,8 @@ struct DdsCommander::Impl {
       for (int id : online_locked()) expect.insert(id);
       for (const auto& [id, a] : got) expect.insert(id);
     }
-    std::vector<int> missing;
+    CommandResult r;
+    std::vector<int>& missing = r.missing;
     std::string rejected;
     int accepted = 0, via_server = 0;
     for (int id : expect) {
@@ -281,11 +298,11 @@ struct DdsCommander::Impl {
       } else if (!it->second.accepted()) {
         rejected += fmt::format("{}rejected by {}: {}", rejected.empty() ? "" : "; ", id,
                                 it->second.reason().to_string());
+        r.rejected.emplace_back(id, it->second.reason().to_string());
       } else {
         ++accepted;
       }
     }
-    CommandResult r;
     r.ok = missing.empty() && rejected.empty();
     r.message = fmt::format("{} {}/{} acknowledged", to_string(c.type), accepted, expect.size());
     if (via_server > 0) r.message += fmt::format(" ({} through the server)", via_server);
@@ -345,7 +362,7 @@ bool DdsCommander::wait_for_server(double timeout_s) {
     }
     return wall_seconds() - since > kMatchQuietS;
   });
-  return !stop_requested();
+  return !I.stopped();
 }
 
 ServerSearch server_search(const std::vector<ServerPeer>& servers, bool secure, bool status_heard) {
@@ -534,7 +551,7 @@ std::string DdsCommander::wait_task(std::function<void(const std::string&)> on_p
       o.scenario = I.scene_name;
       break;
     }
-    if (stop_requested()) {
+    if (I.stopped()) {
       o.reason = "interrupted";
       break;
     }
@@ -650,19 +667,31 @@ SwarmStatus DdsCommander::status() {
 
 std::optional<SwarmSnapshot> DdsCommander::swarm_snapshot(double timeout_s) {
   Impl& m = *impl_;
-  if (!m.state_reader) {
-    m.state_reader =
-        &m.dds.reader<msg::SwarmState>([&m](const msg::SwarmState& s, const fdds::SampleInfo&) {
-          std::lock_guard<std::mutex> lock(m.mu);
-          m.state = s;
-          m.cv.notify_all();
-        });
-  }
+  m.ensure_state_reader();
   std::unique_lock<std::mutex> lock(m.mu);
   m.cv.wait_for(lock, std::chrono::duration<double>(timeout_s),
                 [&] { return m.state.has_value(); });
   if (!m.state) return std::nullopt;
   return snapshot_of(*m.state);
+}
+
+bool DdsCommander::read_swarm_state(double timeout_s, std::int64_t after_tick,
+                                    const std::function<void(const msg::SwarmState&)>& read) {
+  Impl& m = *impl_;
+  m.ensure_state_reader();
+  const bool got = m.wait(timeout_s, [&] {
+    return m.state && static_cast<std::int64_t>(m.state->tick()) > after_tick;
+  });
+  if (!got) return false;
+  std::lock_guard<std::mutex> lock(m.mu);
+  read(*m.state);
+  return true;
+}
+
+void DdsCommander::set_interrupted(bool on) {
+  impl_->interrupted = on;
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  impl_->cv.notify_all();
 }
 
 std::optional<TaskOutcome> DdsCommander::last_task() const {

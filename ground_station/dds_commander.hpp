@@ -15,6 +15,10 @@
 #include "ground_station/gs_config.hpp"
 #include "ground_station/trace.hpp"
 
+namespace ddswarm::msg {
+class SwarmState;
+}
+
 namespace ddswarm::gs {
 
 /// A finished (or failed) task as the server refereed it.
@@ -139,6 +143,17 @@ class DdsCommander final : public Commander {
   /// nullopt if none came. Read on this ground station's own participant,
   /// already matched with the server: no second join just to look.
   std::optional<SwarmSnapshot> swarm_snapshot(double timeout_s);
+
+  /// Calls read with the latest swarm state newer than after_tick (-1: any),
+  /// waiting up to timeout_s for one; false when none came. Shares
+  /// swarm_snapshot's reader.
+  bool read_swarm_state(double timeout_s, std::int64_t after_tick,
+                        const std::function<void(const msg::SwarmState&)>& read);
+
+  /// While on, every blocking call returns as on a stop request (SIGINT),
+  /// for a caller that waits on another thread and is interrupted there
+  /// (the Python binding: Ctrl-C and per-call timeouts).
+  void set_interrupted(bool on);
 
   /// The last task's outcome, once wait_task() returned.
   std::optional<TaskOutcome> last_task() const;

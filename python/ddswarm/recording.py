@@ -20,6 +20,9 @@ class Table(dict):
             raise AttributeError(name) from None
 
     def __len__(self):
+        """Samples of a recorded topic; fields of a live one (GroundStation.state)."""
+        if "log_time_s" not in self:
+            return super().__len__()
         return len(self["log_time_s"])
 
 
