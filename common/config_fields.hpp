@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -184,7 +185,7 @@ class FieldLister {
       def = std::to_string(v);
     } else if constexpr (std::is_floating_point_v<T>) {
       type = "real";
-      def = to_text(v);
+      def = exact(v);
     } else if constexpr (std::is_same_v<T, std::string>) {
       def = v;
     } else if constexpr (requires {
@@ -192,7 +193,7 @@ class FieldLister {
                            v.cols();
                          }) {  // an Eigen vector
       type = v.size() == 2 ? "[x, y]" : "[x, y, z]";
-      for (int k = 0; k < v.size(); ++k) def += (k ? ", " : "[") + to_text(v[k]);
+      for (int k = 0; k < v.size(); ++k) def += (k ? ", " : "[") + exact(v[k]);
       def += "]";
     } else {  // a list
       type = "list";
@@ -225,6 +226,15 @@ class FieldLister {
 
   std::string prefix;  ///< "" or "section."
   std::vector<FieldRow> rows;
+
+ private:
+  /// A default as written in the code (to_text keeps 6 digits: 6396.667 would read 6396.67).
+  static std::string exact(double v) {
+    std::ostringstream os;
+    os.precision(10);
+    os << v;
+    return os.str();
+  }
 };
 
 /// The reference rows of config struct C (C::fields on a default C).

@@ -29,4 +29,11 @@ double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above,
   return alpha * std::exp(-0.5 * (dxy / beta) * (dxy / beta));
 }
 
+Eigen::Vector3d rotor_drag_force(const Eigen::Vector3d& c, const Eigen::Vector3d& v_air_body,
+                                 const std::array<double, 4>& omega_rad_s) {
+  const double w = std::abs(omega_rad_s[0]) + std::abs(omega_rad_s[1]) + std::abs(omega_rad_s[2]) +
+                   std::abs(omega_rad_s[3]);
+  return -w * c.cwiseProduct(v_air_body);
+}
+
 }  // namespace ddswarm::sim

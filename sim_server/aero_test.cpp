@@ -39,3 +39,19 @@ TEST(Downwash, HalfAMetreBelowAnotherDroneTheForceIsTheModels) {
   // Where the model's beta passes through 0 (dz = 0.6875 m) the force stays finite.
   EXPECT_TRUE(std::isfinite(downwash_force(c, above, Vector3d(0.01, 0, 1.5 - 0.6875), r)));
 }
+
+TEST(RotorDrag, TheForceIsLinearInAirspeedAndRotorSpeedAgainstTheAirspeed) {
+  // F = -c (.) v sum |omega|: the Crazyflie's coefficients (Förster) at 2 m/s
+  // forward, 1 m/s left and 0.5 m/s up, rotors at 1500 rad/s.
+  const Vector3d c(9.1785e-7, 9.1785e-7, 10.311e-7), v(2, 1, 0.5);
+  const std::array<double, 4> w{1500, 1500, 1500, 1500};
+  const Vector3d f = rotor_drag_force(c, v, w);
+  EXPECT_NEAR(f.x(), -9.1785e-7 * 2 * 6000, 1e-15);
+  EXPECT_NEAR(f.y(), -9.1785e-7 * 1 * 6000, 1e-15);
+  EXPECT_NEAR(f.z(), -10.311e-7 * 0.5 * 6000, 1e-15);
+  // Linear: twice the airspeed or the rotor speeds, twice the force; a
+  // rotor's direction of spin does not matter.
+  EXPECT_TRUE(rotor_drag_force(c, 2 * v, w).isApprox(2 * f, 1e-12));
+  EXPECT_TRUE(rotor_drag_force(c, v, {3000, 3000, -3000, -3000}).isApprox(2 * f, 1e-12));
+  EXPECT_EQ(rotor_drag_force(c, v, {0, 0, 0, 0}), Vector3d::Zero());
+}

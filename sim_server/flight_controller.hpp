@@ -55,9 +55,50 @@ struct ControllerConfig {
   double rate_d_rp = 0.0;    ///< -, roll/pitch rate D gain on measured angular acceleration, >= 0
   double rate_d_lpf_hz = 50.0;  ///< Hz, low-pass cutoff of the D term's derivative, > 0
 
+  /// The gains and limits tuned for an airframe (generic: the defaults above).
+  static ControllerConfig preset(Airframe a);
+
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.field("max_speed_mps", c.max_speed_mps,
+            {"m/s", positive(), "horizontal speed command limit"});
+    v.field("max_vertical_speed_mps", c.max_vertical_speed_mps,
+            {"m/s", positive(), "vertical speed command limit"});
+    v.field("max_yaw_rate_rad_s", c.max_yaw_rate_rad_s,
+            {"rad/s", positive(), "yaw-rate command limit"});
+    v.field("max_yaw_accel_rad_s2", c.max_yaw_accel_rad_s2,
+            {"rad/s^2", positive(), "slew rate of the yaw-rate command"});
+    v.field("max_tilt_rad", c.max_tilt_rad, {"rad", up_to(1.2), "tilt of the thrust vector"});
+    v.field("max_accel_mps2", c.max_accel_mps2,
+            {"m/s^2", positive(),
+             "horizontal and vertical acceleration limit; downward also limited to 0.8 g"});
+    v.field("vel_p_xy", c.vel_p_xy, {"1/s", positive(), "horizontal velocity P gain"});
+    v.field("vel_p_z", c.vel_p_z, {"1/s", positive(), "vertical velocity P gain"});
+    v.field("vel_i_xy", c.vel_i_xy, {"1/s^2", non_negative(), "horizontal velocity I gain"});
+    v.field("vel_i_z", c.vel_i_z, {"1/s^2", non_negative(), "vertical velocity I gain"});
+    v.field("vel_i_max_mps2", c.vel_i_max_mps2,
+            {"m/s^2", non_negative(), "integrator clamp per axis group"});
+    v.field("vel_i_band_mps", c.vel_i_band_mps,
+            {"m/s", positive(), "the integrators see the velocity error clamped to this"});
+    v.field("drag_feedforward", c.drag_feedforward,
+            {"", any(), "cancel the modelled body drag at the measured velocity"});
+    v.field("att_p_rp", c.att_p_rp, {"1/s", positive(), "roll/pitch attitude P gain"});
+    v.field("att_p_yaw", c.att_p_yaw,
+            {"1/s", positive(), "yaw attitude gain, applied as weight att_p_yaw/att_p_rp"});
+    v.field("max_body_rate_rad_s", c.max_body_rate_rad_s,
+            {"rad/s", positive(), "body-rate setpoint limit, every axis"});
+    v.field("rate_p_rp", c.rate_p_rp, {"1/s", positive(), "roll/pitch rate P gain"});
+    v.field("rate_p_yaw", c.rate_p_yaw, {"1/s", positive(), "yaw rate P gain"});
+    v.field("rate_d_rp", c.rate_d_rp,
+            {"-", non_negative(), "roll/pitch rate D gain on measured angular acceleration"});
+    v.field("rate_d_lpf_hz", c.rate_d_lpf_hz,
+            {"Hz", positive(), "low-pass cutoff of the D term's derivative"});
+  }
+
   void validate() const;  ///< throws FieldError("controller.…")
 };
 
+/// Reads section `controller` over c (defaults or an airframe's preset).
 void load(YamlSection s, ControllerConfig& c);
 
 /// What the drone is told to do (world frame ENU).

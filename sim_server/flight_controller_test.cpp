@@ -270,5 +270,71 @@ TEST(FlightController, HoverDemandAtRestIsTheWeight) {
   for (double w : fc.status().mix.omega_rad_s) EXPECT_NEAR(w, q.hover_omega(), 1e-6);
 }
 
+// ------------------------------------------------------------ per airframe
+
+class AirframeFlight : public ::testing::TestWithParam<Airframe> {
+ protected:
+  Flight flight(double yaw0 = 0.0) const {
+    return Flight(0.001, yaw0, QuadrotorParams::preset(GetParam()),
+                  ControllerConfig::preset(GetParam()));
+  }
+  QuadrotorParams params() const { return QuadrotorParams::preset(GetParam()); }
+};
+
+TEST_P(AirframeFlight, AtSteadyHoverEachRotorCarriesAQuarterOfTheWeight) {
+  Flight f = flight();
+  f.take_off();
+  f.run(5.0);
+  const QuadrotorParams q = params();
+  const double quarter = q.mass_kg * kGravityMps2 / 4;
+  // What the controller commands, and what the lagged rotors deliver.
+  for (double t : f.controller().status().mix.thrust_n) EXPECT_NEAR(t, quarter, 0.005 * quarter);
+  for (double w : f.world().rotor_speeds(0)) EXPECT_NEAR(q.k_f() * w * w, quarter, 0.005 * quarter);
+  EXPECT_LT(f.state().v_world.norm(), 0.005);
+}
+
+TEST_P(AirframeFlight, TracksHorizontalVelocityStepsWithoutOvershoot) {
+  // 1 m/s (the thesis task's speeds are 0.8 m/s toward the goal plus the
+  // law's reactions) and 3 m/s steps along an oblique heading.
+  for (double target : {1.0, 3.0}) {
+    Flight f = flight(0.6);
+    f.take_off();
+    const double z0 = f.state().p_world.z();
+    const Eigen::Vector3d dir(std::cos(0.3), std::sin(0.3), 0.0);
+    const StepResponse r = measure_step(f, dir, target, 6.0, 4.0);
+    EXPECT_GT(r.t90_s, 0.0) << target;
+    EXPECT_LT(r.t90_s, target > 2 ? 1.5 : 1.0) << target << " m/s: 90 % within the bound";
+    EXPECT_LT(r.peak, 1.05 * target) << target << " m/s: overshoot below 5 %";
+    EXPECT_LT(r.late_err, 0.03 * target) << target << " m/s: steady error after 4 s";
+    EXPECT_LT(r.cross, 0.05 * target) << target << " m/s: no sideways drift";
+    EXPECT_LT(std::abs(f.state().p_world.z() - z0), 0.1) << target << " m/s: holds altitude";
+    f.sp.v_world.setZero();
+    f.run(4.0);
+    EXPECT_LT(f.state().v_world.norm(), 0.03) << target << " m/s: stops again";
+  }
+}
+
+TEST_P(AirframeFlight, TracksVerticalVelocityStepsWithoutOvershoot) {
+  Flight f = flight();
+  f.take_off();
+  const Eigen::Vector3d up(0, 0, 1);
+  const StepResponse climb = measure_step(f, up, 1.0, 4.0, 3.0);
+  EXPECT_LT(climb.t90_s, 1.0);
+  EXPECT_LT(climb.peak, 1.05);
+  EXPECT_LT(climb.late_err, 0.03);
+  f.sp.v_world.setZero();
+  f.run(3.0);
+  const StepResponse sink = measure_step(f, -up, 1.0, 3.0, 2.5);
+  EXPECT_LT(sink.t90_s, 1.3);
+  EXPECT_LT(sink.peak, 1.05);
+  EXPECT_LT(sink.late_err, 0.03);
+}
+
+INSTANTIATE_TEST_SUITE_P(Airframes, AirframeFlight,
+                         ::testing::Values(Airframe::kGeneric, Airframe::kCrazyflie),
+                         [](const ::testing::TestParamInfo<Airframe>& p) {
+                           return airframe_name(p.param);
+                         });
+
 }  // namespace
 }  // namespace ddswarm::sim

@@ -266,16 +266,34 @@ class DroneDynamicsWorld final : public btDiscreteDynamicsWorld {
 PhysicsWorld::PhysicsWorld(const SceneConfig& scene, const QuadrotorParams& q,
                            const std::vector<Eigen::Vector3d>& start_positions,
                            double start_yaw_rad, BulletPath path)
-    : params_(q),
-      ground_z_m_(scene.ground_z_m),
-      k_f_(q.k_f()),
-      k_m_(q.k_m()),
-      omega_min_(q.omega_min_rad_s),
-      omega_max_(q.omega_max_rad_s()) {
+    : PhysicsWorld(scene, std::vector<QuadrotorParams>{q},
+                   std::vector<int>(start_positions.size(), 0), start_positions, start_yaw_rad,
+                   path) {}
+
+PhysicsWorld::PhysicsWorld(const SceneConfig& scene, const std::vector<QuadrotorParams>& airframes,
+                           const std::vector<int>& airframe_of,
+                           const std::vector<Eigen::Vector3d>& start_positions,
+                           double start_yaw_rad, BulletPath path)
+    : ground_z_m_(scene.ground_z_m) {
   if (start_positions.size() >= (1u << 20))
     throw std::invalid_argument("PhysicsWorld: too many drones (" +
                                 std::to_string(start_positions.size()) + ")");
-  for (int i = 0; i < 4; ++i) rotor_pos_[i] = q.rotor_position_body(i);
+  if (airframes.empty() || airframe_of.size() != start_positions.size())
+    throw std::invalid_argument("PhysicsWorld: one airframe index per drone needed");
+  for (int a : airframe_of)
+    if (a < 0 || a >= static_cast<int>(airframes.size()))
+      throw std::invalid_argument("PhysicsWorld: airframe index " + std::to_string(a));
+  for (const QuadrotorParams& q : airframes) {
+    Model m{q, q.k_f(), q.k_m(), q.omega_min_rad_s, q.omega_max_rad_s(), {}, nullptr};
+    for (int i = 0; i < 4; ++i) m.rotor_pos[i] = q.rotor_position_body(i);
+    m.shape = std::make_unique<btCylinderShapeZ>(to_bt(
+        Eigen::Vector3d(q.collision_radius_m, q.collision_radius_m, q.collision_half_height_m)));
+    m.shape->setMargin(
+        std::min(kShapeMarginM, static_cast<btScalar>(q.collision_half_height_m / 2)));
+    models_.push_back(std::move(m));
+  }
+  lag_up_.resize(models_.size());
+  lag_down_.resize(models_.size());
 
   collision_config_ = std::make_unique<btDefaultCollisionConfiguration>();
   broadphase_ = std::make_unique<btDbvtBroadphase>();
@@ -335,21 +353,18 @@ PhysicsWorld::PhysicsWorld(const SceneConfig& scene, const QuadrotorParams& q,
     add_static(std::move(shape), Eigen::Vector3d::Zero(), 0.0, ContactKind::kObstacle, index++);
   }
 
-  drone_shape_ = std::make_unique<btCylinderShapeZ>(to_bt(
-      Eigen::Vector3d(q.collision_radius_m, q.collision_radius_m, q.collision_half_height_m)));
-  drone_shape_->setMargin(
-      std::min(kShapeMarginM, static_cast<btScalar>(q.collision_half_height_m / 2)));
-  const btVector3 inertia = to_bt(q.inertia());
   drones_.reserve(start_positions.size());
   for (std::size_t i = 0; i < start_positions.size(); ++i) {
-    btRigidBody::btRigidBodyConstructionInfo info(static_cast<btScalar>(q.mass_kg), nullptr,
-                                                  drone_shape_.get(), inertia);
+    const Model& m = models_[airframe_of[i]];
+    btRigidBody::btRigidBodyConstructionInfo info(static_cast<btScalar>(m.p.mass_kg), nullptr,
+                                                  m.shape.get(), to_bt(m.p.inertia()));
     Drone d;
+    d.model = airframe_of[i];
     d.body = std::make_unique<btRigidBody>(info);
     d.body->setActivationState(DISABLE_DEACTIVATION);
     d.body->setUserIndex(static_cast<int>(i));
     d.body->setUserIndex2(static_cast<int>(ContactKind::kDrone));
-    place(*d.body, start_positions[i], start_yaw_rad);
+    place(*d.body, m.p.collision_half_height_m, start_positions[i], start_yaw_rad);
     world_->addRigidBody(d.body.get());
     drones_.push_back(std::move(d));
   }
@@ -388,10 +403,11 @@ void PhysicsWorld::add_static(std::unique_ptr<btCollisionShape> shape,
   statics_.push_back(std::move(body));
 }
 
-void PhysicsWorld::place(btRigidBody& body, const Eigen::Vector3d& bottom, double yaw_rad) const {
+void PhysicsWorld::place(btRigidBody& body, double half_height_m, const Eigen::Vector3d& bottom,
+                         double yaw_rad) const {
   btTransform t;
   t.setIdentity();
-  t.setOrigin(to_bt(bottom + Eigen::Vector3d(0, 0, params_.collision_half_height_m)));
+  t.setOrigin(to_bt(bottom + Eigen::Vector3d(0, 0, half_height_m)));
   t.setRotation(btQuaternion(btVector3(0, 0, 1), static_cast<btScalar>(yaw_rad)));
   body.setWorldTransform(t);
   body.setInterpolationWorldTransform(t);
@@ -403,49 +419,60 @@ void PhysicsWorld::place(btRigidBody& body, const Eigen::Vector3d& bottom, doubl
 }
 
 void PhysicsWorld::set_rotor_commands(int drone, const std::array<double, 4>& omega_cmd_rad_s) {
-  auto& cmd = drones_[drone].omega_cmd;
-  for (int i = 0; i < 4; ++i) cmd[i] = std::clamp(omega_cmd_rad_s[i], omega_min_, omega_max_);
+  Drone& d = drones_[drone];
+  const Model& m = models_[d.model];
+  for (int i = 0; i < 4; ++i)
+    d.omega_cmd[i] = std::clamp(omega_cmd_rad_s[i], m.omega_min, m.omega_max);
 }
 
 void PhysicsWorld::step(double dt) {
-  const double tau = params_.motor_tau_s;
-  const double lag = tau > 0 ? 1.0 - std::exp(-dt / tau) : 1.0;  // exact first-order step
-  const Eigen::Vector3d& c_quad = params_.drag_quadratic_body;
-  const double c_lin = params_.drag_linear_n_per_mps;
-  const double c_ang = params_.angular_drag_nm_per_rad_s;
-
-  const double prop_r = 0.5 * params_.prop_diameter_m;
+  // Exact first-order steps; a rotor slowing down may lag more than one speeding up.
+  for (std::size_t k = 0; k < models_.size(); ++k) {
+    const double tau = models_[k].p.motor_tau_s;
+    const double tau_down = models_[k].p.motor_tau_down_s > 0 ? models_[k].p.motor_tau_down_s : tau;
+    lag_up_[k] = tau > 0 ? 1.0 - std::exp(-dt / tau) : 1.0;
+    lag_down_[k] = tau_down > 0 ? 1.0 - std::exp(-dt / tau_down) : 1.0;
+  }
   for (std::size_t n = 0; n < drones_.size(); ++n) {
     Drone& d = drones_[n];
+    const Model& m = models_[d.model];
+    const Eigen::Vector3d& c_quad = m.p.drag_quadratic_body;
+    const double c_lin = m.p.drag_linear_n_per_mps;
+    const double c_ang = m.p.angular_drag_nm_per_rad_s;
+    const double prop_r = 0.5 * m.p.prop_diameter_m;
+    const double lag_up = lag_up_[d.model], lag_down = lag_down_[d.model];
     double thrust = 0.0;
     Eigen::Vector3d torque_b(0, 0, 0);
     btRigidBody& body = *d.body;
     const Eigen::Matrix3d r = to_eigen(body.getWorldTransform().getBasis());
     const Eigen::Vector3d p = to_eigen(body.getWorldTransform().getOrigin());
     for (int i = 0; i < 4; ++i) {
+      const double lag = d.omega_cmd[i] >= d.omega[i] ? lag_up : lag_down;
       d.omega[i] += lag * (d.omega_cmd[i] - d.omega[i]);
       const double w2 = d.omega[i] * d.omega[i];
-      double t = k_f_ * w2;
+      double t = m.k_f * w2;
       // Each rotor's hub height above the ground sets its ground effect.
       if (aero_.ground_effect)
-        t *= ground_effect_ratio((p + r * rotor_pos_[i]).z() - ground_z_m_, prop_r);
+        t *= ground_effect_ratio((p + r * m.rotor_pos[i]).z() - ground_z_m_, prop_r);
       thrust += t;
-      torque_b.x() += rotor_pos_[i].y() * t;
-      torque_b.y() -= rotor_pos_[i].x() * t;
-      torque_b.z() -= QuadrotorParams::rotor_spin(i) * k_m_ * w2;
+      torque_b.x() += m.rotor_pos[i].y() * t;
+      torque_b.y() -= m.rotor_pos[i].x() * t;
+      torque_b.z() -= QuadrotorParams::rotor_spin(i) * m.k_m * w2;
     }
     // Drag acts on the airspeed: the velocity relative to the air (the wind).
     const Eigen::Vector3d v_b = r.transpose() * (to_eigen(body.getLinearVelocity()) - d.air_world);
     const Eigen::Vector3d w_b = r.transpose() * to_eigen(body.getAngularVelocity());
     Eigen::Vector3d force_b = -c_quad.cwiseProduct(v_b.cwiseProduct(v_b.cwiseAbs())) - c_lin * v_b;
+    if (aero_.rotor_drag) force_b += rotor_drag_force(m.p.rotor_drag_body, v_b, d.omega);
     force_b.z() += thrust;
     torque_b -= c_ang * w_b;
     Eigen::Vector3d force_w = r * force_b;
     if (aero_.downwash)
-      for (std::size_t m = 0; m < drones_.size(); ++m)
-        if (m != n)
-          force_w.z() -= downwash_force(
-              aero_, to_eigen(drones_[m].body->getWorldTransform().getOrigin()), p, prop_r);
+      for (std::size_t u = 0; u < drones_.size(); ++u)
+        if (u != n)
+          force_w.z() -=
+              downwash_force(aero_, to_eigen(drones_[u].body->getWorldTransform().getOrigin()), p,
+                             0.5 * models_[drones_[u].model].p.prop_diameter_m);
     body.applyCentralForce(to_bt(force_w));
     body.applyTorque(to_bt(r * torque_b));
   }
@@ -538,7 +565,7 @@ void PhysicsWorld::reset_drone(int drone, const Eigen::Vector3d& p, double yaw_r
   // Re-adding the body drops its stale contact manifolds and lets the
   // broadphase find its new neighbours at once.
   world_->removeRigidBody(d.body.get());
-  place(*d.body, p, yaw_rad);
+  place(*d.body, models_[d.model].p.collision_half_height_m, p, yaw_rad);
   world_->addRigidBody(d.body.get());
   d.omega_cmd.fill(0.0);
   d.omega.fill(0.0);
@@ -565,8 +592,9 @@ void PhysicsWorld::ray_target(const btCollisionObject* o, RayTarget& t) const {
     const btTransform& tr = o->getWorldTransform();
     t.center = to_eigen(tr.getOrigin());
     t.rot = to_eigen(tr.getBasis());
-    const Eigen::Vector3d half(params_.collision_radius_m, params_.collision_radius_m,
-                               params_.collision_half_height_m);
+    const QuadrotorParams& q = models_[drones_[t.index].model].p;
+    const Eigen::Vector3d half(q.collision_radius_m, q.collision_radius_m,
+                               q.collision_half_height_m);
     extent = t.rot.cwiseAbs() * half;
   } else {
     const ObstacleShape& s = obstacle_shapes_[t.index];
@@ -584,8 +612,9 @@ void PhysicsWorld::ray_target(const btCollisionObject* o, RayTarget& t) const {
 double PhysicsWorld::ray_distance(const RayTarget& t, const Eigen::Vector3d& o,
                                   const Eigen::Vector3d& d, double t_max) const {
   if (t.drone) {
+    const QuadrotorParams& q = models_[drones_[t.index].model].p;
     return ray_cylinder_z(t.rot.transpose() * (o - t.center), t.rot.transpose() * d,
-                          params_.collision_radius_m, params_.collision_half_height_m, t_max);
+                          q.collision_radius_m, q.collision_half_height_m, t_max);
   }
   const ObstacleShape& s = obstacle_shapes_[t.index];
   if (s.mesh) return ray_mesh(*s.mesh, o, d, t_max);

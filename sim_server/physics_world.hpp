@@ -74,6 +74,12 @@ class PhysicsWorld {
   PhysicsWorld(const SceneConfig& scene, const QuadrotorParams& q,
                const std::vector<Eigen::Vector3d>& start_positions, double start_yaw_rad,
                BulletPath path = BulletPath::kShortcuts);
+  /// A swarm of several airframes: drone i flies airframes[airframe_of[i]]
+  /// (airframe_of has one entry per start position, each indexing airframes).
+  PhysicsWorld(const SceneConfig& scene, const std::vector<QuadrotorParams>& airframes,
+               const std::vector<int>& airframe_of,
+               const std::vector<Eigen::Vector3d>& start_positions, double start_yaw_rad,
+               BulletPath path = BulletPath::kShortcuts);
   ~PhysicsWorld();
   PhysicsWorld(const PhysicsWorld&) = delete;
   PhysicsWorld& operator=(const PhysicsWorld&) = delete;
@@ -91,7 +97,7 @@ class PhysicsWorld {
   void set_air_velocity(int drone, const Eigen::Vector3d& air_world) {
     drones_[drone].air_world = air_world;
   }
-  /// Ground effect and downwash (sim/aero.hpp); off unless set.
+  /// Ground effect, downwash and rotor drag (sim/aero.hpp); off unless set.
   void set_aero(const AeroConfig& aero) { aero_ = aero; }
 
   /// Advances one fixed step of dt seconds: motor lag, rotor thrust k_f w^2 at
@@ -140,11 +146,22 @@ class PhysicsWorld {
 
   void set_ray_cast_mode(RayCastMode mode) { ray_mode_ = mode; }
 
-  const QuadrotorParams& params() const { return params_; }
+  /// The first airframe (the only one unless several were given).
+  const QuadrotorParams& params() const { return models_[0].p; }
+  /// The airframe drone flies.
+  const QuadrotorParams& params(int drone) const { return models_[drones_[drone].model].p; }
 
  private:
+  /// One airframe: its parameters and what step() needs of them, cached.
+  struct Model {
+    QuadrotorParams p;
+    double k_f, k_m, omega_min, omega_max;
+    std::array<Eigen::Vector3d, 4> rotor_pos;
+    std::unique_ptr<btCollisionShape> shape;  ///< shared by its drones
+  };
   struct Drone {
     std::unique_ptr<btRigidBody> body;
+    int model = 0;  ///< index into models_
     std::array<double, 4> omega_cmd{};
     std::array<double, 4> omega{};
     Eigen::Vector3d air_world{0, 0, 0};
@@ -182,15 +199,14 @@ class PhysicsWorld {
                       double t_max) const;
   void add_static(std::unique_ptr<btCollisionShape> shape, const Eigen::Vector3d& origin,
                   double yaw_rad, ContactKind kind, int index);
-  void place(btRigidBody& body, const Eigen::Vector3d& bottom, double yaw_rad) const;
+  void place(btRigidBody& body, double half_height_m, const Eigen::Vector3d& bottom,
+             double yaw_rad) const;
   void update_contacts(bool report);
 
-  QuadrotorParams params_;
+  std::vector<Model> models_;
   double ground_z_m_;
   AeroConfig aero_;
-  // Rotor model, cached from params_.
-  double k_f_, k_m_, omega_min_, omega_max_;
-  std::array<Eigen::Vector3d, 4> rotor_pos_;
+  std::vector<double> lag_up_, lag_down_;  ///< scratch: per model, this step's motor lag
 
   // Bullet objects, in construction order (destroyed in reverse).
   std::unique_ptr<btDefaultCollisionConfiguration> collision_config_;
@@ -201,7 +217,6 @@ class PhysicsWorld {
   std::vector<std::unique_ptr<btTriangleMesh>> triangle_meshes_;  ///< outlive their shapes
   std::vector<std::unique_ptr<btCollisionShape>>
       static_shapes_;                                  ///< ground, cylinders, boxes, meshes
-  std::unique_ptr<btCollisionShape> drone_shape_;      ///< shared by all drones
   std::vector<std::unique_ptr<btRigidBody>> statics_;  ///< ground, then obstacles
   std::vector<Drone> drones_;
   std::vector<ObstacleShape> obstacle_shapes_;  ///< by obstacle index

@@ -1,6 +1,7 @@
 #include "sim_server/quadrotor.hpp"
 
 #include <cmath>
+#include <map>
 #include <numbers>
 
 namespace ddswarm::sim {
@@ -27,55 +28,89 @@ double yaw_of(const Eigen::Quaterniond& q_world_body) {
   return std::atan2(x.y(), x.x());
 }
 
+const Choices<Airframe>& airframe_names() {
+  static const Choices<Airframe> names = {{"generic", Airframe::kGeneric},
+                                          {"crazyflie", Airframe::kCrazyflie}};
+  return names;
+}
+
+std::string airframe_name(Airframe a) {
+  for (const auto& [name, value] : airframe_names())
+    if (value == a) return name;
+  return "?";
+}
+
+QuadrotorParams QuadrotorParams::preset(Airframe a) {
+  QuadrotorParams q;
+  if (a == Airframe::kGeneric) return q;
+  // Bitcraze Crazyflie 2.x. Mass, thrust and torque coefficients and the
+  // rotor-drag coefficients are J. Förster, "System Identification of the
+  // Crazyflie 2.0 Nano Quadrocopter", BSc thesis, ETH Zürich IDSC 2015 (the
+  // values gym-pybullet-drones' cf2x.urdf and BaseAviary use, rounded there
+  // to kf 3.16e-10, km 7.94e-12; DRAG_COEFF_XY/Z 9.1785e-7/10.311e-7 kg/rad);
+  // the inertia is the diagonal of Förster's identified tensor
+  // ([16.57, 16.66, 29.26] 1e-6 kg m^2, as CrazyS's crazyflie2.xacro and
+  // the Crazyflie firmware's physical_constants quote it). Arm: half the
+  // 92 mm motor-to-motor diagonal (Bitcraze; CrazyS arm_length 0.046).
+  // Propeller radius 23.13 mm (gym-pybullet-drones PROP_RADIUS). Full speed
+  // gives a thrust-to-weight ratio of 2.25 (cf2x.urdf thrust2weight).
+  // Motor time constants 12.5 ms up, 25 ms down: CrazyS (G. Silano et al.,
+  // "CrazyS: a software-in-the-loop platform for the Crazyflie 2.0
+  // nano-quadcopter", ECC 2018), crazyflie2.xacro time_constant_up/down.
+  q.airframe = a;
+  q.mass_kg = 0.027;
+  q.arm_length_m = 0.046;
+  q.body_box_m = {0.092, 0.092, 0.03};  // inertia is given: not used for it
+  q.motor_mass_kg = 0.0;
+  q.rotor_z_m = 0.0;
+  q.inertia_kgm2 = {1.6572e-5, 1.6656e-5, 2.9262e-5};
+  q.prop_diameter_m = 0.0462696;
+  q.k_f_n_per_rpm2 = 3.1582e-10;
+  q.k_m_nm_per_rpm2 = 7.9379e-12;
+  q.max_rpm = 21716.0;  // sqrt(2.25 m g / (4 k_F))
+  q.omega_min_rad_s = 0.0;
+  q.motor_tau_s = 0.0125;
+  q.motor_tau_down_s = 0.025;
+  // Body drag by AirSim's face-area formula (0.325/2 rho A per axis), with
+  // A = 92 mm x 30 mm from the side and four propeller discs plus the body
+  // from above; the rotors' own drag (below) is what Förster measured.
+  q.drag_quadratic_body = {5.5e-4, 5.5e-4, 1.9e-3};
+  q.drag_linear_n_per_mps = 0.0;
+  // The generic quad's rate damping per unit inertia (5e-4 / 6.7e-3 1/s).
+  q.angular_drag_nm_per_rad_s = 1.2e-6;
+  q.rotor_drag_body = {9.1785e-7, 9.1785e-7, 10.311e-7};
+  // Arm plus propeller radius (69 mm); the frame is 29 mm tall with its battery.
+  q.collision_radius_m = 0.07;
+  q.collision_half_height_m = 0.015;
+  return q;
+}
+
 void load(YamlSection s, QuadrotorParams& c) {
-  s.get("mass_kg", c.mass_kg);
-  s.get("arm_length_m", c.arm_length_m);
-  s.get("body_box_m", c.body_box_m);
-  s.get("motor_mass_kg", c.motor_mass_kg);
-  s.get("rotor_z_m", c.rotor_z_m);
-  s.get("inertia_kgm2", c.inertia_kgm2);
-  s.get("thrust_coeff", c.thrust_coeff);
-  s.get("power_coeff", c.power_coeff);
-  s.get("prop_diameter_m", c.prop_diameter_m);
-  s.get("air_density_kgm3", c.air_density_kgm3);
-  s.get("max_rpm", c.max_rpm);
-  s.get("omega_min_rad_s", c.omega_min_rad_s);
-  s.get("motor_tau_s", c.motor_tau_s);
-  s.get("drag_quadratic_body", c.drag_quadratic_body);
-  s.get("drag_linear_n_per_mps", c.drag_linear_n_per_mps);
-  s.get("angular_drag_nm_per_rad_s", c.angular_drag_nm_per_rad_s);
-  s.get("collision_radius_m", c.collision_radius_m);
-  s.get("collision_half_height_m", c.collision_half_height_m);
+  // The preset first: every other key overrides it.
+  Airframe a = c.airframe;
+  s.get_enum("airframe", a,
+             std::map<std::string, Airframe>(airframe_names().begin(), airframe_names().end()));
+  if (a != c.airframe) c = QuadrotorParams::preset(a);
+  FieldLoader load(s);
+  QuadrotorParams::fields(c, load);
   s.finish();
 }
 
 void QuadrotorParams::validate() const {
-  check_positive("quadrotor.mass_kg", mass_kg);
-  check_positive("quadrotor.arm_length_m", arm_length_m);
+  FieldChecker check("quadrotor");
+  QuadrotorParams::fields(*this, check);
   check_vector_positive("quadrotor.body_box_m", body_box_m);
-  check_non_negative("quadrotor.motor_mass_kg", motor_mass_kg);
   if (!(4 * motor_mass_kg < mass_kg))
     throw FieldError("quadrotor.motor_mass_kg", to_text(motor_mass_kg),
                      "four motors must weigh less than mass_kg");
-  check_non_negative("quadrotor.rotor_z_m", rotor_z_m);
   check_vector_non_negative("quadrotor.inertia_kgm2", inertia_kgm2);
   if (!inertia_kgm2.isZero(0.0)) check_vector_positive("quadrotor.inertia_kgm2", inertia_kgm2);
-  check_positive("quadrotor.thrust_coeff", thrust_coeff);
-  check_positive("quadrotor.power_coeff", power_coeff);
-  check_positive("quadrotor.prop_diameter_m", prop_diameter_m);
-  check_positive("quadrotor.air_density_kgm3", air_density_kgm3);
-  check_positive("quadrotor.max_rpm", max_rpm);
-  check_non_negative("quadrotor.omega_min_rad_s", omega_min_rad_s);
   if (!(omega_min_rad_s < omega_max_rad_s()))
     throw FieldError(
         "quadrotor.omega_min_rad_s", to_text(omega_min_rad_s),
         "must be below omega_max (" + to_text(omega_max_rad_s()) + " rad/s from max_rpm)");
-  check_non_negative("quadrotor.motor_tau_s", motor_tau_s);
   check_vector_non_negative("quadrotor.drag_quadratic_body", drag_quadratic_body);
-  check_non_negative("quadrotor.drag_linear_n_per_mps", drag_linear_n_per_mps);
-  check_non_negative("quadrotor.angular_drag_nm_per_rad_s", angular_drag_nm_per_rad_s);
-  check_positive("quadrotor.collision_radius_m", collision_radius_m);
-  check_positive("quadrotor.collision_half_height_m", collision_half_height_m);
+  check_vector_non_negative("quadrotor.rotor_drag_body", rotor_drag_body);
   // Hovering must leave headroom for attitude control.
   if (!(4 * max_rotor_thrust_n() > 1.1 * mass_kg * kGravityMps2))
     throw FieldError("quadrotor.mass_kg", to_text(mass_kg),
@@ -86,11 +121,14 @@ void QuadrotorParams::validate() const {
 double QuadrotorParams::omega_max_rad_s() const { return max_rpm / 60.0 * kTwoPi; }
 
 double QuadrotorParams::k_f() const {
+  // rpm = omega * 60 / 2pi.
+  if (k_f_n_per_rpm2 > 0) return k_f_n_per_rpm2 * (60.0 / kTwoPi) * (60.0 / kTwoPi);
   // thrust = C_T rho n^2 D^4 with n = omega / 2pi.
   return thrust_coeff * air_density_kgm3 * std::pow(prop_diameter_m, 4) / (kTwoPi * kTwoPi);
 }
 
 double QuadrotorParams::k_m() const {
+  if (k_m_nm_per_rpm2 > 0) return k_m_nm_per_rpm2 * (60.0 / kTwoPi) * (60.0 / kTwoPi);
   // torque = C_P rho n^2 D^5 / 2pi with n = omega / 2pi.
   return power_coeff * air_density_kgm3 * std::pow(prop_diameter_m, 5) / (kTwoPi * kTwoPi * kTwoPi);
 }
@@ -143,23 +181,17 @@ Wrench QuadrotorParams::rotor_wrench(const std::array<double, 4>& omega_rad_s) c
 }
 
 void load(YamlSection s, SensorConfig& c) {
-  s.get("count", c.count);
-  s.get("max_range_m", c.max_range_m);
-  s.get("min_range_m", c.min_range_m);
-  s.get("noise_sigma_m", c.noise_sigma_m);
-  s.get("yaw_offset_rad", c.yaw_offset_rad);
+  FieldLoader load(s);
+  SensorConfig::fields(c, load);
   s.finish();
 }
 
 void SensorConfig::validate() const {
-  check_range("sensors.count", count, 1, 64);
-  check_positive("sensors.min_range_m", min_range_m);
-  check_positive("sensors.max_range_m", max_range_m);
+  FieldChecker check("sensors");
+  SensorConfig::fields(*this, check);
   if (!(max_range_m > min_range_m))
     throw FieldError("sensors.max_range_m", to_text(max_range_m),
                      "must exceed min_range_m (" + to_text(min_range_m) + ")");
-  check_non_negative("sensors.noise_sigma_m", noise_sigma_m);
-  check_range("sensors.yaw_offset_rad", yaw_offset_rad, -kTwoPi, kTwoPi);
 }
 
 }  // namespace ddswarm::sim

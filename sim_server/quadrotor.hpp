@@ -15,7 +15,10 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
+#include <cstdint>
+#include <string>
 
+#include "common/config_fields.hpp"
 #include "common/yaml_section.hpp"
 
 namespace ddswarm::sim {
@@ -40,6 +43,19 @@ struct Wrench {
   Eigen::Vector3d torque_body_nm{0, 0, 0};  ///< N m, body FLU axes
 };
 
+/// The airframes a drone can fly: each names a full set of QuadrotorParams
+/// (QuadrotorParams::preset) and its flight-controller gains
+/// (ControllerConfig::preset). docs/airframes.md gives their sources.
+enum class Airframe : std::uint8_t {
+  kGeneric,    ///< AirSim's generic quadrotor (1 kg), the thesis's vehicle
+  kCrazyflie,  ///< Bitcraze Crazyflie 2.x (27 g, 92 mm motor to motor)
+};
+
+/// The airframes' names in YAML, in the order the reference lists them.
+const Choices<Airframe>& airframe_names();
+/// "generic", "crazyflie".
+std::string airframe_name(Airframe a);
+
 /// Physical description of the quadrotor.
 ///
 /// Defaults are AirSim's "generic quadrotor" (AirSim MultiRotorParams::
@@ -48,8 +64,12 @@ struct Wrench {
 /// motor assemblies for the inertia, propellers with C_T = 0.109919,
 /// C_P = 0.040164, D = 0.2286 m at 6396.667 RPM in air of 1.225 kg/m^3, a
 /// 5 ms motor filter, and AirSim's face-area drag model reduced to one
-/// quadratic coefficient per body axis.
+/// quadratic coefficient per body axis. Its rotor-drag coefficient is PX4's
+/// Gazebo Iris (rotorDragCoefficient 8.06428e-5 in the multicopter motor
+/// model plugin), the one published value for a quadrotor of that size.
 struct QuadrotorParams {
+  Airframe airframe = Airframe::kGeneric;  ///< the preset these values start from
+
   double mass_kg = 1.0;                          ///< kg, total mass, > 0
   double arm_length_m = 0.2275;                  ///< m, centre to rotor axis, > 0
   Eigen::Vector3d body_box_m{0.18, 0.11, 0.04};  ///< m, central box x, y, z, each > 0
@@ -63,18 +83,76 @@ struct QuadrotorParams {
   double power_coeff = 0.040164;    ///< C_P, torque = C_P rho n^2 D^5 / (2 pi), > 0
   double prop_diameter_m = 0.2286;  ///< m, > 0
   double air_density_kgm3 = 1.225;  ///< kg/m^3, > 0
-  double max_rpm = 6396.667;        ///< rev/min at full command (omega_max ~ 669.9 rad/s), > 0
-  double omega_min_rad_s = 0.0;     ///< rad/s, lowest rotor speed, in [0, omega_max)
-  double motor_tau_s = 0.005;       ///< s, first-order rotor speed lag, >= 0 (0 = instant)
+  /// N/rpm^2, thrust = k_F rpm^2 as identified on a thrust stand; > 0
+  /// replaces thrust_coeff (0: from C_T, rho and D).
+  double k_f_n_per_rpm2 = 0.0;
+  /// N m/rpm^2, reaction torque = k_M rpm^2; > 0 replaces power_coeff.
+  double k_m_nm_per_rpm2 = 0.0;
+  double max_rpm = 6396.667;     ///< rev/min at full command (omega_max ~ 669.9 rad/s), > 0
+  double omega_min_rad_s = 0.0;  ///< rad/s, lowest rotor speed, in [0, omega_max)
+  double motor_tau_s = 0.005;    ///< s, first-order rotor speed lag, >= 0 (0 = instant)
+  /// s, the lag while a rotor slows down, >= 0; 0 = motor_tau_s (one lag both ways).
+  double motor_tau_down_s = 0.0;
 
   /// N/(m/s)^2 per body axis: F = -c v|v| (AirSim: 0.325/2 * rho * exposed
   /// area of the box faces plus propellers, per axis).
   Eigen::Vector3d drag_quadratic_body{0.0066, 0.0072, 0.1347};
   double drag_linear_n_per_mps = 0.0;       ///< N/(m/s), extra linear drag on each axis, >= 0
   double angular_drag_nm_per_rad_s = 5e-4;  ///< N m/(rad/s), body rate damping, >= 0
+  /// N/(m/s) per rad/s of rotor speed, per body axis, each >= 0: with
+  /// aero.rotor_drag on, the rotors add F = -c v_air sum_i |omega_i| (body
+  /// axes). z = 0: PX4's model acts across the rotor axis only.
+  Eigen::Vector3d rotor_drag_body{8.06428e-5, 8.06428e-5, 0.0};
 
   double collision_radius_m = 0.3;        ///< m, collision cylinder radius (covers props), > 0
   double collision_half_height_m = 0.05;  ///< m, collision cylinder half height, > 0
+
+  /// The airframe's published parameters (generic: the defaults above).
+  static QuadrotorParams preset(Airframe a);
+
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.choice("airframe", c.airframe, airframe_names(),
+             {"", any(), "the preset the other keys override (docs/airframes.md)"});
+    v.field("mass_kg", c.mass_kg, {"kg", positive(), "total mass"});
+    v.field("arm_length_m", c.arm_length_m, {"m", positive(), "centre to rotor axis"});
+    v.field("body_box_m", c.body_box_m, {"m", any(), "central box, for the inertia"});
+    v.field("motor_mass_kg", c.motor_mass_kg,
+            {"kg", non_negative(), "point mass at each arm tip, for the inertia"});
+    v.field("rotor_z_m", c.rotor_z_m,
+            {"m", non_negative(), "rotor plane above the centre (inertia only)"});
+    v.field(
+        "inertia_kgm2", c.inertia_kgm2,
+        {"kg m^2", any(), "[Ixx, Iyy, Izz] override; all zero computes it from box and motors"});
+    v.field("thrust_coeff", c.thrust_coeff,
+            {"-", positive(), "C_T: thrust = C_T rho n^2 D^4 (n in rev/s)"});
+    v.field("power_coeff", c.power_coeff,
+            {"-", positive(), "C_P: torque = C_P rho n^2 D^5 / (2 pi)"});
+    v.field("prop_diameter_m", c.prop_diameter_m, {"m", positive(), "D"});
+    v.field("air_density_kgm3", c.air_density_kgm3, {"kg/m^3", positive(), "rho"});
+    v.field("k_f_n_per_rpm2", c.k_f_n_per_rpm2,
+            {"N/rpm^2", non_negative(), "k_F: thrust = k_F rpm^2; > 0 replaces thrust_coeff"});
+    v.field("k_m_nm_per_rpm2", c.k_m_nm_per_rpm2,
+            {"N m/rpm^2", non_negative(), "k_M: torque = k_M rpm^2; > 0 replaces power_coeff"});
+    v.field("max_rpm", c.max_rpm, {"rev/min", positive(), "rotor speed at full command"});
+    v.field("omega_min_rad_s", c.omega_min_rad_s, {"rad/s", non_negative(), "lowest rotor speed"});
+    v.field("motor_tau_s", c.motor_tau_s,
+            {"s", non_negative(), "first-order rotor speed lag (0 = instant)"});
+    v.field("motor_tau_down_s", c.motor_tau_down_s,
+            {"s", non_negative(), "the lag while a rotor slows; 0 = motor_tau_s"});
+    v.field("drag_quadratic_body", c.drag_quadratic_body,
+            {"N/(m/s)^2", any(), "F = -c v|v| per body axis"});
+    v.field("drag_linear_n_per_mps", c.drag_linear_n_per_mps,
+            {"N/(m/s)", non_negative(), "extra linear drag on each axis"});
+    v.field("angular_drag_nm_per_rad_s", c.angular_drag_nm_per_rad_s,
+            {"N m/(rad/s)", non_negative(), "body-rate damping"});
+    v.field("rotor_drag_body", c.rotor_drag_body,
+            {"N/(m/s)/(rad/s)", any(), "rotor drag with aero.rotor_drag"});
+    v.field("collision_radius_m", c.collision_radius_m,
+            {"m", positive(), "collision cylinder radius (covers the propellers)"});
+    v.field("collision_half_height_m", c.collision_half_height_m,
+            {"m", positive(), "collision cylinder half height"});
+  }
 
   void validate() const;  ///< throws FieldError("quadrotor.…")
 
@@ -99,6 +177,8 @@ struct QuadrotorParams {
   Wrench rotor_wrench(const std::array<double, 4>& omega_rad_s) const;
 };
 
+/// Reads section `quadrotor`: `airframe` first (the preset, default generic),
+/// then every other key overrides it. Unknown keys throw ConfigError.
 void load(YamlSection s, QuadrotorParams& c);
 
 /// The ring of distance sensors on every drone (the thesis's 8 rangefinders).
@@ -108,6 +188,18 @@ struct SensorConfig {
   double min_range_m = 0.05;    ///< m, > 0; measured ranges are clamped to it
   double noise_sigma_m = 0.02;  ///< m, Gaussian range noise standard deviation, >= 0
   double yaw_offset_rad = 0.0;  ///< rad, body yaw of ray 0, in [-2pi, 2pi]
+
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.field("count", c.count, {"", in(1, 64), "rays, evenly spaced in the body x-y plane"});
+    v.field("max_range_m", c.max_range_m, {"m", positive(), "sensor range"});
+    v.field("min_range_m", c.min_range_m, {"m", positive(), "readings are clamped up to this"});
+    v.field("noise_sigma_m", c.noise_sigma_m,
+            {"m", non_negative(), "Gaussian range noise, standard deviation"});
+    v.field(
+        "yaw_offset_rad", c.yaw_offset_rad,
+        {"rad", in(-2 * 3.14159265358979323846, 2 * 3.14159265358979323846), "body yaw of ray 0"});
+  }
 
   void validate() const;  ///< throws FieldError("sensors.…")
 };

@@ -13,6 +13,7 @@ void ServerConfig::validate() const {
   sim.validate();
   quadrotor.validate();
   controller.validate();
+  (void)fleet();  // the groups' airframes, gains and ids
   sensors.validate();
   scene.validate();
   wind.validate();
@@ -26,13 +27,18 @@ void ServerConfig::validate() const {
   (void)scene.start_positions(scenario.drones, scenario.seed);
 }
 
+Fleet ServerConfig::fleet() const {
+  return make_fleet(quadrotor, controller, airframe_groups, scenario.drones);
+}
+
 ServerConfig load_server_config(const std::string& path) {
   auto doc = load_scenario(path);
   ServerConfig c;
   doc.guard([&] {
     load(doc.section("scenario"), c.scenario);
     load(doc.section("sim"), c.sim);
-    load(doc.section("quadrotor"), c.quadrotor);
+    // The airframe sets the controller's gains; `controller:` goes over them.
+    load_airframes(doc.section("quadrotor"), c.quadrotor, c.controller, c.airframe_groups);
     load(doc.section("controller"), c.controller);
     load(doc.section("sensors"), c.sensors);
     load(doc.section("scene"), c.scene);

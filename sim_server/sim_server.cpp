@@ -83,8 +83,7 @@ struct SimServer::Impl {
         pipelined(cfg.sim.lockstep_pipeline && cfg.scenario.mode == TimeMode::kLockstep),
         rt_pipelined(cfg.sim.realtime_pipeline && cfg.scenario.mode == TimeMode::kRealtime),
         starts(cfg.scene.start_positions(n, cfg.scenario.seed)),
-        swarm(cfg.scene, cfg.quadrotor, cfg.controller, starts, cfg.scenario.seed, cfg.wind,
-              cfg.aero),
+        swarm(cfg.scene, cfg.fleet(), starts, cfg.scenario.seed, cfg.wind, cfg.aero),
         referee(cfg.scene, cfg.sim.metrics()),
         dds(cfg.dds, kServerParticipantName),
         out(dds, cfg.sim),
@@ -392,6 +391,7 @@ struct SimServer::Impl {
         cfg.scenario.name, n, to_string(cfg.scenario.mode),
         pipelined || rt_pipelined ? " (pipelined: commands act one tick later)" : "",
         cfg.sim.physics_rate_hz, cfg.sim.control_rate_hz, cfg.scenario.seed);
+    spdlog::info("ddswarm-sim: airframes: {}", fleet_summary(cfg.fleet()));
     if (!cfg.generated_world.empty())
       spdlog::info("ddswarm-sim: generated world: {}", cfg.generated_world);
     if (!cfg.scene.meshes.empty()) {
@@ -405,8 +405,9 @@ struct SimServer::Impl {
                    cfg.wind.turbulence ? ", Dryden turbulence" : "",
                    cfg.wind.gusts_per_minute > 0 ? ", gusts" : "");
     if (cfg.aero.enabled())
-      spdlog::info("ddswarm-sim: aerodynamics:{}{}", cfg.aero.ground_effect ? " ground effect" : "",
-                   cfg.aero.downwash ? " downwash" : "");
+      spdlog::info("ddswarm-sim: aerodynamics:{}{}{}",
+                   cfg.aero.ground_effect ? " ground effect" : "",
+                   cfg.aero.downwash ? " downwash" : "", cfg.aero.rotor_drag ? " rotor drag" : "");
     if (cfg.scenario.mode == TimeMode::kLockstep)
       run_lockstep(deadline);
     else

@@ -8,6 +8,7 @@
 #include "common/scenario.hpp"
 #include "common/scene.hpp"
 #include "sim_server/aero.hpp"
+#include "sim_server/airframe.hpp"
 #include "sim_server/flight_controller.hpp"
 #include "sim_server/physics_world.hpp"
 #include "sim_server/quadrotor.hpp"
@@ -20,8 +21,9 @@ namespace ddswarm::sim {
 struct ServerConfig {
   ScenarioConfig scenario;
   SimConfig sim;
-  QuadrotorParams quadrotor;
-  ControllerConfig controller;
+  QuadrotorParams quadrotor;                   ///< every drone's airframe, but those in a group
+  ControllerConfig controller;                 ///< its gains
+  std::vector<AirframeGroup> airframe_groups;  ///< quadrotor.groups
   SensorConfig sensors;
   SceneConfig scene;
   WindConfig wind;
@@ -30,6 +32,8 @@ struct ServerConfig {
   /// What scene.generate added (load_server_config generates it), for the log.
   std::string generated_world;
   void validate() const;
+  /// Every drone's airframe (quadrotor, controller and the groups).
+  Fleet fleet() const;
 };
 
 /// Loads and validates path; throws ConfigError "file:line: field = value: reason".

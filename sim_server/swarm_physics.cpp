@@ -2,15 +2,29 @@
 
 namespace ddswarm::sim {
 
+namespace {
+Fleet one_airframe(const QuadrotorParams& q, const ControllerConfig& c, std::size_t drones) {
+  return Fleet{{q}, {c}, std::vector<int>(drones, 0)};
+}
+}  // namespace
+
 SwarmPhysics::SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor,
                            const ControllerConfig& controller,
                            const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed,
                            const WindConfig& wind, const AeroConfig& aero)
-    : world_(scene, quadrotor, starts, scene.start.yaw_rad), wind_(wind, seed) {
+    : SwarmPhysics(scene, one_airframe(quadrotor, controller, starts.size()), starts, seed, wind,
+                   aero) {}
+
+SwarmPhysics::SwarmPhysics(const SceneConfig& scene, const Fleet& fleet,
+                           const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed,
+                           const WindConfig& wind, const AeroConfig& aero)
+    : world_(scene, fleet.quadrotors, fleet.airframe_of, starts, scene.start.yaw_rad),
+      wind_(wind, seed) {
   world_.set_aero(aero);
   const int n = static_cast<int>(starts.size());
   for (int i = 0; i < n; ++i) {
-    controllers_.emplace_back(quadrotor, controller);
+    const int a = fleet.airframe_of[i];
+    controllers_.emplace_back(fleet.quadrotors[a], fleet.controllers[a]);
     controllers_.back().reset(scene.start.yaw_rad);
     // One generator per drone: a drone's noise does not depend on the others.
     sensor_rng_.emplace_back(seed * 1000003ULL + static_cast<std::uint64_t>(i));

@@ -10,6 +10,7 @@
 
 #include "common/scene.hpp"
 #include "sim_server/aero.hpp"
+#include "sim_server/airframe.hpp"
 #include "sim_server/flight_controller.hpp"
 #include "sim_server/physics_world.hpp"
 #include "sim_server/quadrotor.hpp"
@@ -25,6 +26,11 @@ class SwarmPhysics {
   SwarmPhysics(const SceneConfig& scene, const QuadrotorParams& quadrotor,
                const ControllerConfig& controller, const std::vector<Eigen::Vector3d>& starts,
                std::uint64_t seed, const WindConfig& wind = {}, const AeroConfig& aero = {});
+  /// A swarm of several airframes: drone i flies fleet.quadrotors[fleet.airframe_of[i]]
+  /// with fleet.controllers[...] (sim/airframe.hpp); starts.size() == airframe_of.size().
+  SwarmPhysics(const SceneConfig& scene, const Fleet& fleet,
+               const std::vector<Eigen::Vector3d>& starts, std::uint64_t seed,
+               const WindConfig& wind = {}, const AeroConfig& aero = {});
 
   /// Steps one control period: substeps physics steps of dt_s s, drone i
   /// flying setpoints[i]. The wind at each drone is taken once a period, at
@@ -34,6 +40,9 @@ class SwarmPhysics {
                                  double dt_s);
 
   RigidState state(int drone) const { return world_.state(drone); }
+  /// The airframe drone flies.
+  const QuadrotorParams& airframe(int drone) const { return world_.params(drone); }
+  const FlightController& controller(int drone) const { return controllers_[drone]; }
   /// rad/s, actual (lagged) rotor speeds.
   std::array<double, 4> rotor_speeds(int drone) const { return world_.rotor_speeds(drone); }
   /// Casts the drone's distance sensors (PhysicsWorld::cast_rays) with its own generator.
