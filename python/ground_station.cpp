@@ -183,9 +183,20 @@ class GroundStation {
     const double wait_s = timeout_s.value_or(file_.gs.discovery_timeout_s);
     check_range("timeout", wait_s, 0.0, 86400.0);
     gs_ = std::make_unique<DdsCommander>(file_.gs, file_.dds);
-    if (wait && !blocking(wait_s + 5, [&] { return gs_->wait_for_server(wait_s); }))
-      raise(PyExc_TimeoutError, fmt::format("no simulation server found on domain {} within {:g} s",
-                                            file_.dds.domain_id, wait_s));
+    if (!wait) return;
+    bool found = blocking(wait_s + 5, [&] { return gs_->wait_for_server(wait_s); });
+    double waited = wait_s;
+    // As ddswarm-gs does: a server coming up (discovered, not yet heard) is
+    // waited for, unless the caller named its own timeout.
+    if (!found && !timeout_s && gs_->server_search().state == gs::ServerSearch::State::kComingUp) {
+      waited += gs::kServerComingUpS;
+      found = blocking(gs::kServerComingUpS + 5,
+                       [&] { return gs_->wait_for_server(gs::kServerComingUpS); });
+    }
+    if (!found)
+      raise(PyExc_TimeoutError,
+            fmt::format("no simulation server found on domain {} within {:g} s: {}",
+                        file_.dds.domain_id, waited, gs_->server_search().found));
   }
 
   int domain() const { return file_.dds.domain_id; }

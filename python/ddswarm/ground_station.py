@@ -76,7 +76,8 @@ class GroundStation:
 
     Waits up to `timeout` s (default ground_station.discovery_timeout_s) for
     the server: TimeoutError "no simulation server found on domain N within
-    T s". `secure` is a --secure directory (scripts/make-certs).
+    T s: what was found" (as ddswarm-gs says it); without a `timeout`, a server
+    coming up (discovered, not yet heard) is waited for up to 120 s more. `secure` is a --secure directory (scripts/make-certs).
     Every blocking call releases the GIL, takes a timeout (TimeoutError) and
     ends at Ctrl-C (KeyboardInterrupt).
     """
