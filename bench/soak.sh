@@ -113,15 +113,22 @@ check() { if [ "$2" = ok ]; then note "check $1: ok"; else note "check $1: FAILE
 T0=$(now)
 : >"$WORK/checks.txt"; : >"$WORK/recordings.txt"
 touch "$WORK/t0"
-# orphans: shared-memory files made during the soak that no live process maps
-# or holds open (what a killed process leaves until a start clears it).
+# orphans: shared-memory files the soak's processes used (as sampled) that no
+# live process maps or holds open: what a killed process leaves until a start
+# clears it. Other processes' files (a test beside this one) do not count.
+: >"$WORK/shm_seen.txt"
+shm_refs() { # PIDS...: the /dev/shm files they map or hold open
+  for p in "$@"; do
+    awk '$6 ~ /^\/dev\/shm\// { print $6 }' "/proc/$p/maps" 2>/dev/null
+    find "/proc/$p/fd" -lname '/dev/shm/*' -printf '%l\n' 2>/dev/null
+  done
+}
 orphans() {
   local refs="$WORK/.shm_refs"
-  { awk '$6 ~ /^\/dev\/shm\// { print $6 }' /proc/[0-9]*/maps 2>/dev/null
-    find /proc/[0-9]*/fd -lname '/dev/shm/*' -printf '%l\n' 2>/dev/null; } | sort -u >"$refs"
+  shm_refs $(ls /proc | grep -E '^[0-9]+$') | sort -u >"$refs"
   # Domain claims (ddswarm_domain_N.lock) stay by design: an flock, not a segment.
-  find /dev/shm -maxdepth 1 -type f -newer "$WORK/t0" ! -name 'ddswarm_domain_*.lock' | sort |
-    comm -23 - "$refs"
+  sort -u "$WORK/shm_seen.txt" | grep -v '/ddswarm_domain_[0-9]*\.lock$' |
+    while read -r f; do [ -e "$f" ] && echo "$f"; done | comm -23 - "$refs"
 }
 start_server
 for i in $(seq 0 $((DRONES - 1))); do start_agent "$i"; done
@@ -139,6 +146,7 @@ sample_rss() {
     kb=$(awk '/^VmRSS:/ { print $2 }' "/proc/$p/status" 2>/dev/null) || continue
     [ -n "$kb" ] && echo "$p $name $kb $t" >>"$RSS"
   done
+  shm_refs "${PID[@]}" >>"$WORK/shm_seen.txt"
   echo "shm $(orphans | wc -l) $t" >>"$WORK/shm.txt"
 }
 
@@ -234,7 +242,9 @@ timeout 30 "$BIN/ddswarm-sim" --scenario "$scenario" --drones 1 --mode realtime 
 left_files=$(orphans | wc -l)
 [ "$left_files" -eq 0 ] && check "no shared-memory file leaked (at most $shm_max orphans during the soak, 0 after a start)" ok ||
   check "no shared-memory file leaked" FAILED "$left_files files no process holds: $(orphans | head -3 | tr '\n' ' ')"
-# RSS slope per process (least squares, MB per minute) over its samples after its first minute.
+# RSS slope per process (least squares, MB per minute) over its samples after
+# its first two minutes (its warm-up: pools, histories, the law's first
+# neighbours), for a process sampled over at least five minutes after that.
 awk -v bound=1.0 '
   { pid = $1; kb[pid] = kb[pid] " " $3; t[pid] = t[pid] " " $4; name[pid] = $2 }
   END {
@@ -242,12 +252,13 @@ awk -v bound=1.0 '
     for (p in kb) {
       n = split(kb[p], K); split(t[p], T)
       sx = sy = sxx = sxy = m = 0
-      for (i = 1; i <= n; i++) if (T[i] - T[1] >= 60) { x = T[i] / 60; y = K[i] / 1024; sx += x; sy += y; sxx += x * x; sxy += x * y; m++ }
-      if (m < 5 || sxx * m - sx * sx <= 0) continue
+      first = -1; last = -1
+      for (i = 1; i <= n; i++) if (T[i] - T[1] >= 120) { x = T[i] / 60; y = K[i] / 1024; sx += x; sy += y; sxx += x * x; sxy += x * y; m++; if (first < 0) first = T[i]; last = T[i] }
+      if (m < 5 || last - first < 300 || sxx * m - sx * sx <= 0) continue
       s = (m * sxy - sx * sy) / (m * sxx - sx * sx); judged++
       if (s > worst) { worst = s; wn = name[p] }
     }
-    if (judged == 0) { print "n/a (no process lived 5 samples past its first minute)"; exit 0 }
+    if (judged == 0) { print "n/a (no process sampled over 5 min past its first 2)"; exit 0 }
     printf "%.3f MB/min (%s; %d processes judged)\n", worst, wn, judged; exit !(worst < bound)
   }' "$RSS" >"$WORK/rss_slope.txt"
 slope_rc=$?
