@@ -374,8 +374,11 @@ ServerSearch server_search(const std::vector<ServerPeer>& servers, bool secure, 
   if (secure && newest.authenticated_after_s < 0)
     return {State::kComingUp,
             "a server's participant discovered " + ago + ", its DDS Security handshake not passed"};
-  return {State::kComingUp,
-          "a server's participant discovered " + ago + ", none of its status heard yet"};
+  if (secure)
+    return {State::kComingUp,
+            "a server's participant discovered " + ago + ", none of its status heard yet"};
+  return {State::kUnheard, "a server's participant discovered " + ago +
+                               ", none of its status heard (a secure swarm needs --secure)"};
 }
 
 ServerSearch DdsCommander::server_search() const {

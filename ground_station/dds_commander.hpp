@@ -61,11 +61,13 @@ struct ClimbWord {
 /// take-offs (docs/performance.md).
 bool climb_over(const ClimbWord& w);
 
-/// What a ground station found while it looked for the server: nothing, or
-/// a server still coming up (its participant discovered, its handshake or
-/// its endpoints not through yet), or a server it hears.
+/// What a ground station found while it looked for the server: nothing; a
+/// secure server still coming up (its participant discovered, its handshake
+/// or its endpoints not through yet); a server discovered but unheard with
+/// no handshake under way (without DDS Security: a secure swarm's, or one
+/// this process cannot reach), which waiting does not mend; or a server it hears.
 struct ServerSearch {
-  enum class State { kNothing, kComingUp, kHeard };
+  enum class State { kNothing, kComingUp, kUnheard, kHeard };
   State state = State::kNothing;
   std::string found;  ///< one clause for an error line: what was found, what was not
 };
