@@ -134,6 +134,20 @@ probe_swarm() {
   PROBE_LINE=$(grep "^probe ok=1" "$WORK/probe.out") || fail "the probe did not measure the swarm"
 }
 probe_val() { echo "$PROBE_LINE" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
+# web_url: the address `start web ddswarm-gs ... --web 127.0.0.1:0` printed,
+# waited for up to 30 s; returns 1, saying why on stderr, if the bridge exits
+# or prints none (call it as url=$(web_url) || fail ...).
+web_url() {
+  local url=""
+  for _ in $(seq 1 150); do
+    url=$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$WORK/web.log" | head -1)
+    [ -n "$url" ] && { echo "$url"; return 0; }
+    kill -0 "$PID_web" 2>/dev/null || { echo "ddswarm-gs --web exited" >&2; return 1; }
+    sleep 0.2
+  done
+  echo "ddswarm-gs --web printed no URL" >&2
+  return 1
+}
 # commands_fresh: after probe_swarm of a plain real-time swarm, its commands
 # act on the next period (median age 1), in real time, none going stale and
 # few missed. Bounds for a test that may share 2 cores with another: the

@@ -24,14 +24,7 @@ cp "$SRC/config/meshes/bridge.stl" "$SRC/config/meshes/town.obj" "$WORK/meshes/"
 
 start sim "$BIN/ddswarm-sim" --scenario "$CONFIG" --drones 2 --mode lockstep --domain "$DOMAIN"
 start web "$BIN/ddswarm-gs" --config "$CONFIG" --domain "$DOMAIN" --web 127.0.0.1:0
-url=""
-for _ in $(seq 1 150); do
-  url=$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$WORK/web.log" | head -1)
-  [ -n "$url" ] && break
-  kill -0 "$PID_web" 2>/dev/null || fail "ddswarm-gs --web exited"
-  sleep 0.2
-done
-[ -n "$url" ] || fail "ddswarm-gs --web printed no URL"
+url=$(web_url) || fail "no web bridge address"
 for _ in $(seq 1 100); do
   grep -q "mesh obstacle" "$WORK/sim.log" && break
   sleep 0.1

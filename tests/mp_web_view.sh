@@ -21,14 +21,7 @@ for i in $(seq 0 $((N - 1))); do
   start "agent$i" "$BIN/ddswarm-agent" --id "$i" --config "$CONFIG" --drones "$N" --domain "$DOMAIN"
 done
 start web "$BIN/ddswarm-gs" --config "$CONFIG" --domain "$DOMAIN" --web 127.0.0.1:0
-url=""
-for _ in $(seq 1 150); do
-  url=$(grep -o 'http://127\.0\.0\.1:[0-9]*/' "$WORK/web.log" | head -1)
-  [ -n "$url" ] && break
-  kill -0 "$PID_web" 2>/dev/null || fail "ddswarm-gs --web exited"
-  sleep 0.2
-done
-[ -n "$url" ] || fail "ddswarm-gs --web printed no URL"
+url=$(web_url) || fail "no web bridge address"
 echo "bridge at $url"
 timeout 60 "$BIN/ddswarm-gs" --config "$CONFIG" --domain "$DOMAIN" wait-agents --count "$N" || fail "agents did not come online"
 # The run is recorded, for the page's recording player afterwards.
