@@ -13,6 +13,11 @@
 //   us_per_tick   BM_ServerTick: one 50 Hz control tick of a lockstep server's
 //                 compute (physics_hz / 50 substeps of every drone's flight
 //                 controller and step(), then 8 rays of 6 m per drone)
+//   us_per_drone_step  BM_Weather: one control period of SwarmPhysics (the
+//                 wind taken at every drone, then 5 steps of 4 ms: swarm_field's
+//                 250 Hz) per drone and step, calm and plain, with wind
+//                 (3 m/s, Dryden turbulence, gusts), with the aerodynamic
+//                 terms (ground effect, downwash, rotor drag), or with all
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -21,6 +26,7 @@
 #include <vector>
 
 #include "bench/hover_field.hpp"
+#include "sim_server/swarm_physics.hpp"
 
 namespace {
 
@@ -117,6 +123,43 @@ void BM_ServerTick(benchmark::State& state) {
 BENCHMARK(BM_ServerTick)
     ->ArgNames({"drones", "physics_hz"})
     ->ArgsProduct({{6, 16, 32, 64, 128}, {1000, 500, 250}})
+    ->Unit(benchmark::kMicrosecond);
+
+/// args: drones, effects (0 none, 1 wind, 2 aero, 3 both). swarm_field's
+/// start: a lattice 2.5 m apart, hovering at 5 to 5.6 m, so downwash acts.
+void BM_Weather(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const int effects = static_cast<int>(state.range(1));
+  WindConfig wind;
+  if (effects & 1) {
+    wind.steady_mps = {3, 0, 0};
+    wind.turbulence = true;
+    wind.gusts_per_minute = 2;
+  }
+  AeroConfig aero;
+  aero.ground_effect = aero.downwash = aero.rotor_drag = (effects & 2) != 0;
+  const int side = static_cast<int>(std::ceil(std::sqrt(n)));
+  std::vector<Eigen::Vector3d> starts;
+  for (int i = 0; i < n; ++i)
+    starts.emplace_back(2.5 * (i % side), 2.5 * (i / side), 5.0 + 0.3 * (i % 3));
+  SwarmPhysics swarm(ddswarm::SceneConfig{}, QuadrotorParams{}, ControllerConfig{}, starts, 1, wind,
+                     aero);
+  VelocitySetpoint hold;
+  hold.motors_on = true;
+  const std::vector<VelocitySetpoint> setpoints(n, hold);
+  constexpr int kSubsteps = 5;
+  double total_s = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    benchmark::DoNotOptimize(swarm.step(setpoints, kSubsteps, 0.004));
+    total_s += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  state.counters["us_per_drone_step"] =
+      total_s * 1e6 / (static_cast<double>(state.iterations()) * n * kSubsteps);
+}
+BENCHMARK(BM_Weather)
+    ->ArgNames({"drones", "effects"})
+    ->ArgsProduct({{64, 512, 1024}, {0, 1, 2, 3}})
     ->Unit(benchmark::kMicrosecond);
 
 /// One flight-controller update (the server runs one per drone per step).

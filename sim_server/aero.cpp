@@ -22,7 +22,7 @@ double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above,
                       const Eigen::Vector3d& below, double r_m) {
   const double dz = above.z() - below.z();
   const double dxy = (above - below).head<2>().norm();
-  if (!(dz > 0) || dxy >= 10.0) return 0.0;
+  if (!(dz > 0) || dxy >= kDownwashReachM) return 0.0;
   const double k = r_m / (4 * dz);
   const double alpha = c.downwash_c1_n * k * k;
   const double beta = std::max(std::abs(c.downwash_c2 * dz + c.downwash_c3_m), 0.02);

@@ -70,6 +70,9 @@ struct AeroConfig {
 /// T_IGE / T_OGE for a rotor of radius r_m with its hub z_m above the ground.
 double ground_effect_ratio(double z_m, double r_m);
 
+/// m: a drone this far or farther sideways from another feels none of its downwash.
+inline constexpr double kDownwashReachM = 10.0;
+
 /// The downward force (N, >= 0) on a drone at `below` from one at `above`
 /// whose rotors have radius r_m.
 double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above,

@@ -433,6 +433,7 @@ void PhysicsWorld::step(double dt) {
     lag_up_[k] = tau > 0 ? 1.0 - std::exp(-dt / tau) : 1.0;
     lag_down_[k] = tau_down > 0 ? 1.0 - std::exp(-dt / tau_down) : 1.0;
   }
+  if (aero_.downwash) find_downwash_neighbours();
   for (std::size_t n = 0; n < drones_.size(); ++n) {
     Drone& d = drones_[n];
     const Model& m = models_[d.model];
@@ -468,17 +469,65 @@ void PhysicsWorld::step(double dt) {
     torque_b -= c_ang * w_b;
     Eigen::Vector3d force_w = r * force_b;
     if (aero_.downwash)
-      for (std::size_t u = 0; u < drones_.size(); ++u)
-        if (u != n)
-          force_w.z() -=
-              downwash_force(aero_, to_eigen(drones_[u].body->getWorldTransform().getOrigin()), p,
-                             0.5 * models_[drones_[u].model].p.prop_diameter_m);
+      for (std::size_t k = downwash_begin_[n]; k < downwash_begin_[n + 1]; ++k) {
+        const int u = downwash_from_[k];
+        force_w.z() -= downwash_force(aero_, downwash_p_[u], p,
+                                      0.5 * models_[drones_[u].model].p.prop_diameter_m);
+      }
     body.applyCentralForce(to_bt(force_w));
     body.applyTorque(to_bt(r * torque_b));
   }
   world_->stepSimulation(static_cast<btScalar>(dt), 0);
   time_s_ += dt;
   update_contacts(true);
+}
+
+void PhysicsWorld::find_downwash_neighbours() {
+  const std::size_t count = drones_.size();
+  downwash_p_.resize(count);
+  cells_.clear();
+  // A grid cell per kDownwashReachM square: a pair within reach of each other
+  // sits in the same or adjacent cells. Far-off cells are clamped, which keeps
+  // adjacency; a drone with a non-finite position is in none (it feels and
+  // gives no downwash, as downwash_force says of it).
+  auto cell_of = [](double x) {
+    return static_cast<std::int64_t>(std::clamp(std::floor(x / kDownwashReachM), -1e8, 1e8));
+  };
+  auto key = [](std::int64_t cx, std::int64_t cy) {
+    return (static_cast<std::uint64_t>(cx) << 32) ^ static_cast<std::uint32_t>(cy);
+  };
+  for (std::size_t n = 0; n < count; ++n) {
+    const Eigen::Vector3d p = to_eigen(drones_[n].body->getWorldTransform().getOrigin());
+    downwash_p_[n] = p;
+    if (p.allFinite()) cells_.push_back({key(cell_of(p.x()), cell_of(p.y())), static_cast<int>(n)});
+  }
+  std::sort(cells_.begin(), cells_.end());
+  constexpr double kReach2 = kDownwashReachM * kDownwashReachM * (1 + 1e-9);
+  downwash_from_.clear();
+  downwash_begin_.assign(count + 1, 0);
+  for (std::size_t n = 0; n < count; ++n) {
+    downwash_begin_[n] = downwash_from_.size();
+    const Eigen::Vector3d& p = downwash_p_[n];
+    if (!p.allFinite()) continue;
+    const std::int64_t cx = cell_of(p.x()), cy = cell_of(p.y());
+    for (std::int64_t dx = -1; dx <= 1; ++dx)
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        const std::uint64_t k = key(cx + dx, cy + dy);
+        for (auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(k, 0));
+             it != cells_.end() && it->first == k; ++it)
+          if (it->second != static_cast<int>(n)) {
+            // Only a drone above and within reach can push (downwash_force
+            // decides at the edge: the margin keeps every pair it would take).
+            const Eigen::Vector3d d = downwash_p_[it->second] - p;
+            if (d.z() > 0 && d.head<2>().squaredNorm() < kReach2)
+              downwash_from_.push_back(it->second);
+          }
+      }
+    // Index order, as every pair summed in turn would give.
+    std::sort(downwash_from_.begin() + static_cast<std::ptrdiff_t>(downwash_begin_[n]),
+              downwash_from_.end());
+  }
+  downwash_begin_[count] = downwash_from_.size();
 }
 
 void PhysicsWorld::update_contacts(bool report) {

@@ -177,6 +177,11 @@ class PhysicsWorld {
     double last_touch_s;
   };
 
+  std::vector<Eigen::Vector3d> downwash_p_;           ///< each drone's position this step
+  std::vector<std::pair<std::uint64_t, int>> cells_;  ///< (grid cell, drone), sorted
+  std::vector<int> downwash_from_;                    ///< neighbours, drone by drone
+  std::vector<std::size_t> downwash_begin_;           ///< drone n's: [begin[n], begin[n + 1])
+
   /// Exact geometry of an obstacle, for ray casts.
   struct ObstacleShape {
     Eigen::Vector3d center;
@@ -193,6 +198,12 @@ class PhysicsWorld {
     Eigen::Matrix3d rot;     ///< drones: body -> world
     Eigen::Vector3d aabb_min, aabb_max;
   };
+
+  /// Fills downwash_from_: for each drone, the others above it and within
+  /// kDownwashReachM of it sideways, in index order. Drones are binned on a grid of that
+  /// size, so a step costs O(N k) for k drones near each, not O(N^2); the
+  /// forces and their order of summation are those of every pair.
+  void find_downwash_neighbours();
 
   void ray_target(const btCollisionObject* o, RayTarget& t) const;
   double ray_distance(const RayTarget& t, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,

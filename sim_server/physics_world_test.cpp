@@ -216,6 +216,45 @@ TEST(PhysicsWorld, DownwashPushesADroneHalfAMetreBelowAnotherAsTheModelSays) {
   EXPECT_NEAR((a_low - a_top) * q.mass_kg, -force, 0.05 * force);
 }
 
+TEST(PhysicsWorld, DownwashReachesADroneAcrossTheNeighbourGridsCellLines) {
+  // The server finds who is above whom on a 10 m grid; a pair 2 cm apart
+  // sideways across a cell line (at x = 10, at y = -10, at the origin's
+  // corner) is pushed as one within a cell is.
+  QuadrotorParams q;
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs = {
+      {{5, 5, 20.5}, {5.02, 5, 20}},          // one cell
+      {{9.99, 100, 20.5}, {10.01, 100, 20}},  // across x = 10
+      {{100, -9.99, 20.5}, {100, -10.01, 20}},
+      {{-100.01, -0.01, 20.5}, {-99.99, 0.01, 20}}};  // across x = -100 and y = 0
+  std::vector<Eigen::Vector3d> starts;
+  for (const auto& [top, low] : pairs) starts.insert(starts.end(), {top, low});
+  PhysicsWorld w(empty_scene(), q, starts, 0.0);
+  AeroConfig a;
+  a.downwash = true;
+  w.set_aero(a);
+  const double h = q.hover_omega();
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    w.reset_drone(static_cast<int>(i), starts[i], 0.0);
+    w.set_rotor_commands(static_cast<int>(i), {h, h, h, h});
+  }
+  step_for(w, 0.02);
+  std::vector<double> v0;
+  for (std::size_t i = 0; i < starts.size(); ++i)
+    v0.push_back(w.state(static_cast<int>(i)).v_world.z());
+  step_for(w, 0.005);
+  std::vector<double> pushed;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const int top = static_cast<int>(2 * k), low = top + 1;
+    const double force =
+        downwash_force(a, w.state(top).p_world, w.state(low).p_world, 0.5 * q.prop_diameter_m);
+    const double a_top = (w.state(top).v_world.z() - v0[top]) / 0.005;
+    const double a_low = (w.state(low).v_world.z() - v0[low]) / 0.005;
+    pushed.push_back((a_top - a_low) * q.mass_kg);
+    EXPECT_NEAR(pushed.back(), force, 0.05 * force) << "pair " << k;
+  }
+  EXPECT_GT(pushed[0], 1.0);
+}
+
 TEST(PhysicsWorld, RotorTorquesTurnTheBodyTheWayTheModelSays) {
   QuadrotorParams q;
   const double h = q.hover_omega();
