@@ -736,14 +736,20 @@ std::string write_metrics_plot(const std::vector<SetSummary>& sets, const std::s
     dat << "\"\n";
   }
   write_text(dir + "/metrics.dat", dat.str());
+  // Room above the tallest distance bar for its label; the legend goes under
+  // the plot, clear of every bar.
+  double top_m = 0.1;
+  for (const auto& s : sets)
+    if (std::isfinite(s.min_inter_drone_m)) top_m = std::max(top_m, s.min_inter_drone_m);
   std::ostringstream gp;
   gp << "data = " << gnuplot_string("metrics.dat") << "\n"  // gnuplot runs in dir
      << "set title 'Swarm metrics per set: order and closest approach'\n"
      << "set style fill solid 0.6 border -1\nset boxwidth 0.35\nset grid ytics\n"
      << "set xrange [-0.6:" << sets.size() - 0.4 << "]\nset xtics rotate by -30\n"
      << "set ylabel 'Order (velocity correlation)'\nset yrange [-1:1.15]\n"
-     << "set y2label 'Min. inter-drone distance [m]'\nset y2range [0:*]\nset y2tics\n"
-     << "set ytics nomirror\nset key top left\n"
+     << "set y2label 'Min. inter-drone distance [m]'\nset y2range [0:" << number_text(1.2 * top_m)
+     << "]\nset y2tics\n"
+     << "set ytics nomirror\nset key below horizontal\n"
      << "plot data using 1:(1/0):xtic(6) notitle, \\\n"  // the set's name under its pair
      << "     data using ($1-0.2):2 with boxes lc rgb '#2ca02c' title 'order, mean of the runs', "
         "\\\n"
