@@ -26,7 +26,10 @@ double downwash_force(const AeroConfig& c, const Eigen::Vector3d& above,
   const double k = r_m / (4 * dz);
   const double alpha = c.downwash_c1_n * k * k;
   const double beta = std::max(std::abs(c.downwash_c2 * dz + c.downwash_c3_m), 0.02);
-  return alpha * std::exp(-0.5 * (dxy / beta) * (dxy / beta));
+  const double q = 0.5 * (dxy / beta) * (dxy / beta);
+  // exp(-q) is exactly 0 there: skip its slow underflow path.
+  if (q > 746.0) return 0.0;
+  return alpha * std::exp(-q);
 }
 
 Eigen::Vector3d rotor_drag_force(const Eigen::Vector3d& c, const Eigen::Vector3d& v_air_body,

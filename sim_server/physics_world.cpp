@@ -433,7 +433,7 @@ void PhysicsWorld::step(double dt) {
     lag_up_[k] = tau > 0 ? 1.0 - std::exp(-dt / tau) : 1.0;
     lag_down_[k] = tau_down > 0 ? 1.0 - std::exp(-dt / tau_down) : 1.0;
   }
-  if (aero_.downwash) find_downwash_neighbours();
+  if (aero_.downwash) update_downwash_candidates();
   for (std::size_t n = 0; n < drones_.size(); ++n) {
     Drone& d = drones_[n];
     const Model& m = models_[d.model];
@@ -470,9 +470,14 @@ void PhysicsWorld::step(double dt) {
     Eigen::Vector3d force_w = r * force_b;
     if (aero_.downwash)
       for (std::size_t k = downwash_begin_[n]; k < downwash_begin_[n + 1]; ++k) {
+        // Only a drone above and within reach pushes (downwash_force decides
+        // at the edge: the margin keeps every pair it would take).
         const int u = downwash_from_[k];
-        force_w.z() -= downwash_force(aero_, downwash_p_[u], p,
-                                      0.5 * models_[drones_[u].model].p.prop_diameter_m);
+        const Eigen::Vector3d d = downwash_p_[u] - p;
+        constexpr double kReach2 = kDownwashReachM * kDownwashReachM * (1 + 1e-9);
+        if (d.z() > 0 && d.head<2>().squaredNorm() < kReach2)
+          force_w.z() -= downwash_force(aero_, downwash_p_[u], p,
+                                        0.5 * models_[drones_[u].model].p.prop_diameter_m);
       }
     body.applyCentralForce(to_bt(force_w));
     body.applyTorque(to_bt(r * torque_b));
@@ -482,27 +487,41 @@ void PhysicsWorld::step(double dt) {
   update_contacts(true);
 }
 
-void PhysicsWorld::find_downwash_neighbours() {
+void PhysicsWorld::update_downwash_candidates() {
   const std::size_t count = drones_.size();
   downwash_p_.resize(count);
-  cells_.clear();
-  // A grid cell per kDownwashReachM square: a pair within reach of each other
-  // sits in the same or adjacent cells. Far-off cells are clamped, which keeps
-  // adjacency; a drone with a non-finite position is in none (it feels and
-  // gives no downwash, as downwash_force says of it).
+  bool rebuild = downwash_built_p_.size() != count;
+  constexpr double kHalfSkin2 = 0.25 * kDownwashSkinM * kDownwashSkinM;
+  for (std::size_t n = 0; n < count; ++n) {
+    const Eigen::Vector3d p = to_eigen(drones_[n].body->getWorldTransform().getOrigin());
+    downwash_p_[n] = p;
+    if (rebuild) continue;
+    const Eigen::Vector3d& built = downwash_built_p_[n];
+    if (p.allFinite() != built.allFinite() ||
+        (p.allFinite() && (p - built).head<2>().squaredNorm() > kHalfSkin2))
+      rebuild = true;
+  }
+  if (!rebuild) return;
+  // Every drone has moved less than half the skin sideways since the list was
+  // built, so a pair within reach now was within reach plus the skin then.
+  downwash_built_p_ = downwash_p_;
+  // A grid cell per reach-plus-skin square: such a pair sits in the same or
+  // adjacent cells. Far-off cells are clamped, which keeps adjacency; a drone
+  // with a non-finite position is in none (it feels and gives no downwash, as
+  // downwash_force says of it).
+  constexpr double kCellM = kDownwashReachM + kDownwashSkinM;
   auto cell_of = [](double x) {
-    return static_cast<std::int64_t>(std::clamp(std::floor(x / kDownwashReachM), -1e8, 1e8));
+    return static_cast<std::int64_t>(std::clamp(std::floor(x / kCellM), -1e8, 1e8));
   };
   auto key = [](std::int64_t cx, std::int64_t cy) {
     return (static_cast<std::uint64_t>(cx) << 32) ^ static_cast<std::uint32_t>(cy);
   };
+  cells_.clear();
   for (std::size_t n = 0; n < count; ++n) {
-    const Eigen::Vector3d p = to_eigen(drones_[n].body->getWorldTransform().getOrigin());
-    downwash_p_[n] = p;
+    const Eigen::Vector3d& p = downwash_p_[n];
     if (p.allFinite()) cells_.push_back({key(cell_of(p.x()), cell_of(p.y())), static_cast<int>(n)});
   }
   std::sort(cells_.begin(), cells_.end());
-  constexpr double kReach2 = kDownwashReachM * kDownwashReachM * (1 + 1e-9);
   downwash_from_.clear();
   downwash_begin_.assign(count + 1, 0);
   for (std::size_t n = 0; n < count; ++n) {
@@ -515,13 +534,9 @@ void PhysicsWorld::find_downwash_neighbours() {
         const std::uint64_t k = key(cx + dx, cy + dy);
         for (auto it = std::lower_bound(cells_.begin(), cells_.end(), std::make_pair(k, 0));
              it != cells_.end() && it->first == k; ++it)
-          if (it->second != static_cast<int>(n)) {
-            // Only a drone above and within reach can push (downwash_force
-            // decides at the edge: the margin keeps every pair it would take).
-            const Eigen::Vector3d d = downwash_p_[it->second] - p;
-            if (d.z() > 0 && d.head<2>().squaredNorm() < kReach2)
-              downwash_from_.push_back(it->second);
-          }
+          if (it->second != static_cast<int>(n) &&
+              (downwash_p_[it->second] - p).head<2>().squaredNorm() < kCellM * kCellM)
+            downwash_from_.push_back(it->second);
       }
     // Index order, as every pair summed in turn would give.
     std::sort(downwash_from_.begin() + static_cast<std::ptrdiff_t>(downwash_begin_[n]),

@@ -178,8 +178,9 @@ class PhysicsWorld {
   };
 
   std::vector<Eigen::Vector3d> downwash_p_;           ///< each drone's position this step
+  std::vector<Eigen::Vector3d> downwash_built_p_;     ///< and when the candidates were found
   std::vector<std::pair<std::uint64_t, int>> cells_;  ///< (grid cell, drone), sorted
-  std::vector<int> downwash_from_;                    ///< neighbours, drone by drone
+  std::vector<int> downwash_from_;                    ///< candidates, drone by drone
   std::vector<std::size_t> downwash_begin_;           ///< drone n's: [begin[n], begin[n + 1])
 
   /// Exact geometry of an obstacle, for ray casts.
@@ -199,11 +200,13 @@ class PhysicsWorld {
     Eigen::Vector3d aabb_min, aabb_max;
   };
 
-  /// Fills downwash_from_: for each drone, the others above it and within
-  /// kDownwashReachM of it sideways, in index order. Drones are binned on a grid of that
-  /// size, so a step costs O(N k) for k drones near each, not O(N^2); the
-  /// forces and their order of summation are those of every pair.
-  void find_downwash_neighbours();
+  /// Keeps downwash_from_: for each drone, the others within kDownwashReachM
+  /// plus kDownwashSkinM of it sideways, in index order; rebuilt (on a grid,
+  /// O(N k) for k drones near each) only once a drone has moved half the
+  /// skin. Each step then checks these few; the forces, and the order they
+  /// are summed in, are those of every pair.
+  void update_downwash_candidates();
+  static constexpr double kDownwashSkinM = 2.0;
 
   void ray_target(const btCollisionObject* o, RayTarget& t) const;
   double ray_distance(const RayTarget& t, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
