@@ -50,6 +50,7 @@ msg::SwarmState three_drones() {
   msg::DistanceScan sc;
   sc.drone_id(1);
   sc.angle_body_rad({0.f, 1.5707964f});
+  sc.elevation_body_rad({0.f, 0.3490659f});
   sc.range_m({2.5f, 8.f});
   sc.hit({1, 0});
   s.scans().push_back(sc);
@@ -85,6 +86,18 @@ TEST(WebFrame, RaysOnlyWhenAskedAndEmptyForADroneWithoutAScan) {
   EXPECT_EQ(j["rays"][1]["r"], json::array({2.5, 8}));
   EXPECT_EQ(j["rays"][1]["hit"], json::array({1, 0}));
   EXPECT_NEAR(j["rays"][1]["a"][1].get<double>(), 1.5708, 1e-9);
+  EXPECT_NEAR(j["rays"][1]["e"][1].get<double>(), 0.3491, 1e-9);  // rad, up from the body plane
+}
+
+TEST(WebFrame, AMalformedScanDrawsNoRays) {
+  auto s = three_drones();
+  s.scans()[0].elevation_body_rad().pop_back();  // one elevation short
+  auto j = json::parse(encode_frame(to_frame(s), true));
+  EXPECT_TRUE(j["rays"][1]["a"].empty());
+  s = three_drones();
+  s.scans()[0].elevation_body_rad()[0] = NAN;
+  j = json::parse(encode_frame(to_frame(s), true));
+  EXPECT_TRUE(j["rays"][1]["r"].empty());
 }
 
 TEST(WebFrame, PositionsKeepATenthOfAMillimetre) {
