@@ -235,7 +235,8 @@ std::string scan_problem(const msg::DistanceScan& s) {
   return {};
 }
 
-std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian) {
+std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian,
+                                             ScanLayout layout) {
   msg::SwarmStatePubSubType type;
   eprosima::fastrtps::rtps::SerializedPayload_t p(
       type.getSerializedSizeProvider(const_cast<msg::SwarmState*>(&s))());
@@ -245,7 +246,20 @@ std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_
                                         : eprosima::fastcdr::Cdr::LITTLE_ENDIANNESS,
                              eprosima::fastcdr::Cdr::DDS_CDR);
   cdr.serialize_encapsulation();
-  s.serialize(cdr);
+  if (layout == ScanLayout::kCurrent) {
+    s.serialize(cdr);
+  } else {  // SwarmState.idl's order, each scan without its elevations
+    cdr << s.tick() << s.sim_time_s() << static_cast<std::uint32_t>(s.drones().size());
+    for (const auto& d : s.drones()) d.serialize(cdr);
+    cdr << static_cast<std::uint32_t>(s.scans().size());
+    for (const auto& sc : s.scans())
+      cdr << sc.drone_id() << sc.tick() << sc.sim_time_s() << sc.max_range_m()
+          << sc.angle_body_rad() << sc.range_m() << sc.hit();
+    cdr << static_cast<std::uint32_t>(s.recent_commands().size());
+    for (const auto& c : s.recent_commands()) c.serialize(cdr);
+    cdr << static_cast<std::uint32_t>(s.beacons().size());
+    for (const auto& b : s.beacons()) b.serialize(cdr);
+  }
   return {p.data, p.data + cdr.getSerializedDataLength()};
 }
 

@@ -47,7 +47,10 @@ std::string scan_problem(const msg::DistanceScan& s);
 
 /// The bytes the generated code puts on the wire for `s`, encapsulation
 /// first, in the byte order asked (Fast DDS writes the machine's): what the
-/// decoder is checked against in its test, fuzz target and bench.
-std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian = false);
+/// decoder is checked against in its test, fuzz target and bench. With
+/// kRing64, the bytes a recording made before scans carried elevations
+/// holds (each scan's elevations left out), for the readers' tests.
+std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian = false,
+                                             ScanLayout layout = ScanLayout::kCurrent);
 
 }  // namespace ddswarm

@@ -3,8 +3,6 @@
 // the generated code would refuse or that break the IDL's bounds.
 #include "common/swarm_state_cdr.hpp"
 
-#include <fastcdr/Cdr.h>
-#include <fastcdr/FastBuffer.h>
 #include <fastcdr/exceptions/Exception.h>
 #include <gtest/gtest.h>
 
@@ -314,41 +312,16 @@ TEST(SwarmStateCdr, AMalformedScanIsNamed) {
   EXPECT_EQ(scan_problem(nan_elevation), "ray 2's direction is not finite");
 }
 
-namespace {
-
-/// A SwarmState as recordings made before elevations were written it: each
-/// scan's yaw, range and hit only.
-std::vector<std::uint8_t> ring64_bytes(const msg::SwarmState& s) {
-  std::vector<char> buf(1 << 20);
-  eprosima::fastcdr::FastBuffer fb(buf.data(), buf.size());
-  eprosima::fastcdr::Cdr cdr(fb, eprosima::fastcdr::Cdr::LITTLE_ENDIANNESS,
-                             eprosima::fastcdr::Cdr::DDS_CDR);
-  cdr.serialize_encapsulation();
-  cdr << s.tick() << s.sim_time_s();
-  cdr << static_cast<std::uint32_t>(s.drones().size());
-  for (const auto& d : s.drones()) d.serialize(cdr);
-  cdr << static_cast<std::uint32_t>(s.scans().size());
-  for (const auto& sc : s.scans())
-    cdr << sc.drone_id() << sc.tick() << sc.sim_time_s() << sc.max_range_m() << sc.angle_body_rad()
-        << sc.range_m() << sc.hit();
-  cdr << static_cast<std::uint32_t>(0) << static_cast<std::uint32_t>(0);  // commands, beacons
-  return {buf.data(), buf.data() + cdr.getSerializedDataLength()};
-}
-
-}  // namespace
-
 TEST(SwarmStateCdr, ARecordingFromBeforeElevationsReadsAsALevelRing) {
   std::mt19937 rng(17);
   msg::SwarmState s = random_state(rng, 3);
-  s.recent_commands().clear();
-  s.beacons().clear();
   for (auto& sc : s.scans()) {
     sc.angle_body_rad().resize(std::min<std::size_t>(sc.angle_body_rad().size(), 64));
     sc.range_m().resize(sc.angle_body_rad().size());
     sc.hit().resize(sc.angle_body_rad().size());
     sc.elevation_body_rad().clear();
   }
-  const auto old = ring64_bytes(s);
+  const auto old = encode_swarm_state(s, false, ScanLayout::kRing64);
   msg::SwarmState out;
   EXPECT_FALSE(decode_swarm_state(old.data(), old.size(), out))
       << "the old layout read as the new one";

@@ -10,7 +10,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/mcap/mcap_writer.hpp"
 #include "common/mesh_loader.hpp"
+#include "common/swarm_state_cdr.hpp"
+#include "common/topics.hpp"
+#include "ddswarm_idl_text.hpp"
+#include "ground_station/web/web_recording.hpp"
 
 using namespace ddswarm;
 using namespace ddswarm::gs::web;
@@ -432,4 +437,36 @@ TEST(WebFrame, MeshFilesAreServedOnlyWithTheServersBytes) {
   EXPECT_EQ(j["wind"]["gusts_per_minute"], 2);
   EXPECT_EQ(j["wind"]["gust_max"], 3);
   fs::remove_all(dir);
+}
+
+// A recording made before scans carried elevations: its schema has no
+// DistanceScan.elevation_body_rad and its bytes none. The web view's replay
+// reads its frames, the rays level.
+TEST(WebRecording, ARecordingFromBeforeScanElevationsReplaysWithLevelRays) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("ddswarm_old_" + std::to_string(getpid()) + ".mcap"))
+                               .string();
+  std::string idl = kIdlText;
+  const auto at = idl.find("  sequence<float, 256> elevation_body_rad;");
+  ASSERT_NE(at, std::string::npos);
+  idl.erase(at, idl.find('\n', at) + 1 - at);
+  {
+    mcap::Writer w(path);
+    const auto ch = w.add_channel(w.add_schema("ddswarm::msg::SwarmState", "omgidl", idl),
+                                  Topic<msg::SwarmState>::name, "cdr");
+    for (int k = 0; k < 3; ++k) {
+      auto s = three_drones();
+      s.sim_time_s(1.0 + k);
+      const auto bytes = encode_swarm_state(s, false, ScanLayout::kRing64);
+      w.write(ch, 1'000'000'000ull * (k + 1), 1'000'000'000ull * (k + 1), bytes.data(),
+              bytes.size());
+    }
+    w.close();
+  }
+  const auto rec = load_recording(path, "old.mcap");
+  std::filesystem::remove(path);
+  ASSERT_EQ(rec->frames.size(), 3u);
+  const auto& d = rec->frames[2].drones[1];
+  EXPECT_EQ(d.ray_range, std::vector<float>({2.5f, 8.f}));
+  EXPECT_EQ(d.ray_elevation, std::vector<float>({0.f, 0.f}));
 }

@@ -10,14 +10,13 @@
 // With --crash-after-chunks K it ends without closing the file once K
 // chunks are complete, as a killed recorder does; it prints the swarm-state
 // samples a reader must then find ("swarm_state=N").
-#include <fastcdr/Cdr.h>
-#include <fastcdr/FastBuffer.h>
 #include <CLI/CLI.hpp>
 
 #include <cstdlib>
 #include <iostream>
 
 #include "common/mcap/mcap_writer.hpp"
+#include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
 #include "ddswarm_idl_text.hpp"
 
@@ -32,22 +31,6 @@ std::vector<std::uint8_t> to_cdr(const T& sample) {
   if (!type.serialize(const_cast<T*>(&sample), &payload))
     throw std::runtime_error("cannot serialize");
   return std::vector<std::uint8_t>(payload.data, payload.data + payload.length);
-}
-/// The swarm state as the IDL before scans carried elevations laid it out.
-std::vector<std::uint8_t> ring64_cdr(const msg::SwarmState& s) {
-  std::vector<char> buf(1 << 20);
-  eprosima::fastcdr::FastBuffer fb(buf.data(), buf.size());
-  eprosima::fastcdr::Cdr cdr(fb, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN,
-                             eprosima::fastcdr::Cdr::DDS_CDR);
-  cdr.serialize_encapsulation();
-  cdr << s.tick() << s.sim_time_s() << static_cast<std::uint32_t>(s.drones().size());
-  for (const auto& d : s.drones()) d.serialize(cdr);
-  cdr << static_cast<std::uint32_t>(s.scans().size());
-  for (const auto& sc : s.scans())
-    cdr << sc.drone_id() << sc.tick() << sc.sim_time_s() << sc.max_range_m() << sc.angle_body_rad()
-        << sc.range_m() << sc.hit();
-  cdr << static_cast<std::uint32_t>(0) << static_cast<std::uint32_t>(0);  // commands, beacons
-  return {buf.data(), buf.data() + cdr.getSerializedDataLength()};
 }
 /// That IDL: today's without the elevations.
 std::string ring64_idl() {
@@ -116,7 +99,7 @@ int main(int argc, char** argv) {
       }
       s.scans().push_back(sc);
     }
-    const auto bytes = ring64 ? ring64_cdr(s) : to_cdr(s);
+    const auto bytes = ring64 ? encode_swarm_state(s, false, ScanLayout::kRing64) : to_cdr(s);
     w.write(c_state, t_ns, t_ns, bytes.data(), bytes.size());
     ++states;
     if (w.chunks_written() != chunks) {
