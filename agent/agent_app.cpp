@@ -514,11 +514,13 @@ struct AgentApp::Impl {
       r.ray_range_m = {};
       r.ray_hit = {};
       r.ray_yaw_body_rad = {};
-      if (k < s.scans().size()) {
+      r.ray_elevation_body_rad = {};
+      if (k < s.scans().size()) {  // checked by the drone's brain (DroneRow)
         const auto& sc = s.scans()[k];
         r.ray_range_m = sc.range_m();
         r.ray_hit = sc.hit();
         r.ray_yaw_body_rad = sc.angle_body_rad();
+        r.ray_elevation_body_rad = sc.elevation_body_rad();
       }
       // A drone without a live agent (lost: the server's failsafe flies it,
       // hovering then landing) is no member of the swarm: no attraction to

@@ -220,7 +220,8 @@ law::Observation DroneBrain::observe(const LawInput& in, const MissionOutput& ou
   }
   law_rays_.clear();
   for (std::size_t k = 0; k < in.ray_range_m.size(); ++k)
-    law_rays_.push_back({in.ray_range_m[k], in.ray_hit[k] != 0, in.ray_yaw_body_rad[k], 0.0});
+    law_rays_.push_back({in.ray_range_m[k], in.ray_hit[k] != 0, in.ray_yaw_body_rad[k],
+                         in.ray_elevation_body_rad.empty() ? 0.0 : in.ray_elevation_body_rad[k]});
   o.peers = law_peers_;
   o.rays = law_rays_;
   o.phase = static_cast<law::Phase>(out.phase);
@@ -303,11 +304,19 @@ TickAnswer DroneBrain::tick(const SwarmTick& t) {
   } else {
     in.peers_world = peer_pos;
   }
-  const std::size_t rays =
-      std::min({me->ray_range_m.size(), me->ray_hit.size(), me->ray_yaw_body_rad.size()});
+  std::size_t rays = me->ray_range_m.size();
+  bool sound = me->ray_hit.size() == rays && me->ray_yaw_body_rad.size() == rays &&
+               me->ray_elevation_body_rad.size() == rays;
+  for (std::size_t j = 0; sound && j < rays; ++j)
+    sound = std::isfinite(me->ray_yaw_body_rad[j]) && std::isfinite(me->ray_elevation_body_rad[j]);
+  if (!sound) {  // which ray points where is unknown: none is flown from
+    rays = 0;
+    ++rejected_;
+  }
   ranges_.assign(me->ray_range_m.begin(), me->ray_range_m.begin() + rays);
   hits_.assign(me->ray_hit.begin(), me->ray_hit.begin() + rays);
   angles_.assign(me->ray_yaw_body_rad.begin(), me->ray_yaw_body_rad.begin() + rays);
+  elevations_.assign(me->ray_elevation_body_rad.begin(), me->ray_elevation_body_rad.begin() + rays);
   for (std::size_t j = 0; j < rays; ++j)
     if (!std::isfinite(ranges_[j])) {
       hits_[j] = 0;
@@ -316,6 +325,7 @@ TickAnswer DroneBrain::tick(const SwarmTick& t) {
   in.ray_range_m = ranges_;
   in.ray_hit = hits_;
   in.ray_yaw_body_rad = angles_;
+  in.ray_elevation_body_rad = elevations_;
   set_mission(in, out);
   if (!law_fault_.empty()) fly_fault(in, out, obs);
   Eigen::Vector3d v = Eigen::Vector3d::Zero();

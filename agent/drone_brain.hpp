@@ -38,10 +38,13 @@ struct DroneRow {
   Eigen::Vector3d v_world{0, 0, 0};  ///< m/s, ENU
   Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();
   /// The drone's ray scan, as the sample holds it (the sample outlives the
-  /// tick); rays past the shortest of the three are ignored.
+  /// tick): one entry per ray in each span. A scan whose spans differ in
+  /// length, or with a ray whose yaw or elevation is not finite, is refused
+  /// whole and counted (rejected()); a ray with a non-finite range is no hit.
   std::span<const float> ray_range_m;
   std::span<const std::uint8_t> ray_hit;
   std::span<const float> ray_yaw_body_rad;
+  std::span<const float> ray_elevation_body_rad;  ///< rad, up from the body x-y plane
 };
 
 /// A mission command in the server's ring of recent commands.
@@ -189,7 +192,7 @@ class DroneBrain {
   bool caught_up_ = false;  // the mission in force (the ring) was taken from the first tick
   std::uint64_t rejected_ = 0, sent_ = 0;
   std::vector<Eigen::Vector3d> ranged_;
-  std::vector<float> ranges_, angles_;
+  std::vector<float> ranges_, angles_, elevations_;
   std::vector<std::uint8_t> hits_;
 
   std::unique_ptr<law::SwarmLaw> law_;

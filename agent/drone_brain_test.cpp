@@ -242,16 +242,39 @@ TEST(DroneBrain, ANonFiniteRayIsNoHitAndIsCounted) {
   Swarm s(1);
   s.relay(MissionType::kTakeoff, 2.0);
   s.run(6);
-  const std::vector<float> range{0.5f, NAN}, yaw{0.0f, 3.14f};
+  const std::vector<float> range{0.5f, NAN}, yaw{0.0f, 3.14f}, elevation{0.0f, 0.0f};
   const std::vector<std::uint8_t> hit{1, 1};
   s.sample();
   s.t.drones[0].ray_range_m = range;
   s.t.drones[0].ray_hit = hit;
   s.t.drones[0].ray_yaw_body_rad = yaw;
+  s.t.drones[0].ray_elevation_body_rad = elevation;
   TickAnswer a = s.brains[0]->tick(s.t);
   EXPECT_EQ(s.brains[0]->rejected(), 1u);
   // The one sound ray, half a metre ahead: the sensor term pushes back.
   EXPECT_LT(a.command.velocity.x(), -0.1);
+}
+
+TEST(DroneBrain, AScanWithMismatchedSequencesOrANonFiniteElevationIsRefusedAndCounted) {
+  Swarm s(1);
+  s.relay(MissionType::kTakeoff, 2.0);
+  s.run(6);
+  const std::vector<float> range{0.5f, 0.5f}, yaw{0.0f, 0.0f}, bad_elevation{0.0f, NAN},
+      short_elevation{0.0f};
+  const std::vector<std::uint8_t> hit{1, 1};
+  for (const auto* elevation : {&bad_elevation, &short_elevation}) {
+    s.sample();
+    s.t.drones[0].ray_range_m = range;
+    s.t.drones[0].ray_hit = hit;
+    s.t.drones[0].ray_yaw_body_rad = yaw;
+    s.t.drones[0].ray_elevation_body_rad = *elevation;
+    const std::uint64_t before = s.brains[0]->rejected();
+    TickAnswer a = s.brains[0]->tick(s.t);
+    EXPECT_EQ(s.brains[0]->rejected(), before + 1);
+    // Two hits half a metre ahead would push back hard; the refused scan does not.
+    EXPECT_GT(a.command.velocity.x(), -0.05);
+    s.run(0.02);  // the next tick
+  }
 }
 
 TEST(DroneBrain, AFaultedLawHoversThenLandsAndRefusesMissions) {

@@ -30,7 +30,7 @@ class FixedLaw final : public law::SwarmLaw {
 /// One drone's tick, random but valid, as the agent hands it to a law.
 struct Tick {
   std::vector<Eigen::Vector3d> peers;
-  std::vector<float> range, yaw;
+  std::vector<float> range, yaw, elevation;
   std::vector<std::uint8_t> hit;
   std::vector<law::Peer> law_peers;
   std::vector<law::Ray> law_rays;
@@ -47,8 +47,10 @@ struct Tick {
       peers.push_back(in.p_world + Eigen::Vector3d(s * u(g), s * u(g), j % 2 ? 0.0 : 0.5 * u(g)));
     }
     const int rays = (g() % 2) ? 12 : 0;
+    const bool rows = rays && g() % 2;  // 3 rows of 4, or the ring of 12
     for (int k = 0; k < rays; ++k) {
-      yaw.push_back(static_cast<float>(2 * M_PI * k / rays));
+      yaw.push_back(static_cast<float>(rows ? 2 * M_PI * (k % 4) / 4 : 2 * M_PI * k / rays));
+      elevation.push_back(rows ? static_cast<float>(0.3 * (k / 4 - 1)) : 0.0f);
       hit.push_back(g() % 3 == 0);
       range.push_back(static_cast<float>(3.0 + 3.0 * u(g)));
     }
@@ -57,6 +59,7 @@ struct Tick {
     in.ray_range_m = range;
     in.ray_hit = hit;
     in.ray_yaw_body_rad = yaw;
+    in.ray_elevation_body_rad = elevation;
     in.mission_velocity = Eigen::Vector3d(u(g), u(g), 0.3 * u(g));
     in.inter_distance_m = 3 + u(g);
     in.swarm_enabled = g() % 4 != 0;
@@ -67,7 +70,7 @@ struct Tick {
     for (std::size_t j = 0; j < peers.size(); ++j)
       law_peers.push_back({static_cast<int>(j + 1), peers[j], {0, 0, 0}, 0});
     for (std::size_t k = 0; k < range.size(); ++k)
-      law_rays.push_back({range[k], hit[k] != 0, yaw[k], 0});
+      law_rays.push_back({range[k], hit[k] != 0, yaw[k], elevation[k]});
     o.p_world = in.p_world;
     o.q_world_body = in.q_world_body;
     o.peers = law_peers;

@@ -118,29 +118,48 @@ double sensor_activation(double range_m, bool hit, const SensorFunctionConfig& s
   return 0.0;
 }
 
-Eigen::Vector3d ray_direction_world(double ray_yaw_body_rad,
-                                    const Eigen::Quaterniond& q_world_body) {
+Eigen::Vector3d ray_direction_world(double ray_yaw_body_rad, const Eigen::Quaterniond& q_world_body,
+                                    double ray_elevation_body_rad) {
   const Eigen::Vector3d body(std::cos(ray_yaw_body_rad), std::sin(ray_yaw_body_rad), 0.0);
   Eigen::Vector3d w = q_world_body * body;
   w.z() = 0.0;
   const double n = w.norm();
-  return n > kTiny ? Eigen::Vector3d(w / n) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d h = n > kTiny ? Eigen::Vector3d(w / n) : Eigen::Vector3d::Zero();
+  if (ray_elevation_body_rad == 0.0) return h;
+  const double ce = std::cos(ray_elevation_body_rad);
+  return {ce * h.x(), ce * h.y(), std::sin(ray_elevation_body_rad)};
+}
+
+double ray_weight(std::span<const float> ray_elevation_body_rad) {
+  if (ray_elevation_body_rad.empty()) return 1.0;
+  std::size_t columns = 0;
+  for (const float e : ray_elevation_body_rad) columns += e == ray_elevation_body_rad[0];
+  // columns >= 1 unless ray 0's elevation is NaN; then every ray counts fully.
+  return columns == 0
+             ? 1.0
+             : static_cast<double>(columns) / static_cast<double>(ray_elevation_body_rad.size());
 }
 
 Eigen::Vector3d obstacle_avoidance(std::span<const float> range_m,
                                    std::span<const std::uint8_t> hit,
                                    std::span<const float> ray_yaw_body_rad,
+                                   std::span<const float> ray_elevation_body_rad,
                                    const Eigen::Quaterniond& q_world_body,
                                    const SensorFunctionConfig& s) {
-  if (range_m.size() != hit.size() || range_m.size() != ray_yaw_body_rad.size())
-    throw std::invalid_argument("obstacle_avoidance: ray spans differ in size (range " +
-                                std::to_string(range_m.size()) + ", hit " +
-                                std::to_string(hit.size()) + ", yaw " +
-                                std::to_string(ray_yaw_body_rad.size()) + ")");
+  if (range_m.size() != hit.size() || range_m.size() != ray_yaw_body_rad.size() ||
+      (!ray_elevation_body_rad.empty() && ray_elevation_body_rad.size() != range_m.size()))
+    throw std::invalid_argument(
+        "obstacle_avoidance: ray spans differ in size (range " + std::to_string(range_m.size()) +
+        ", hit " + std::to_string(hit.size()) + ", yaw " + std::to_string(ray_yaw_body_rad.size()) +
+        ", elevation " + std::to_string(ray_elevation_body_rad.size()) + ")");
+  const double w = ray_weight(ray_elevation_body_rad);
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < range_m.size(); ++k) {
     const double f = sensor_activation(range_m[k], hit[k] != 0, s);
-    if (f > 0) c -= f * ray_direction_world(ray_yaw_body_rad[k], q_world_body);
+    if (f > 0)
+      c -= w * f *
+           ray_direction_world(ray_yaw_body_rad[k], q_world_body,
+                               ray_elevation_body_rad.empty() ? 0.0 : ray_elevation_body_rad[k]);
   }
   return c;
 }
@@ -159,7 +178,12 @@ LawTerms frame_law(const LawInput& in, const Eigen::Vector3d& swarm, Eigen::Vect
   t.swarm = swarm;
   if (in.obstacle_avoidance_enabled && obstacle_term) {
     t.obstacle = obstacle_avoidance(in.ray_range_m, in.ray_hit, in.ray_yaw_body_rad,
-                                    in.q_world_body, c.sensor_function);
+                                    in.ray_elevation_body_rad, in.q_world_body, c.sensor_function);
+    auto direction = [&](std::size_t k) {
+      return ray_direction_world(
+          in.ray_yaw_body_rad[k], in.q_world_body,
+          in.ray_elevation_body_rad.empty() ? 0.0 : in.ray_elevation_body_rad[k]);
+    };
     const double safety = c.sensor_function.safety_distance_m;
     if (safety > 0) {
       Eigen::Vector3d away = Eigen::Vector3d::Zero();
@@ -167,7 +191,7 @@ LawTerms frame_law(const LawInput& in, const Eigen::Vector3d& swarm, Eigen::Vect
         const float r = in.ray_range_m[k];
         if (in.ray_hit[k] == 0 || std::isnan(r) || r >= safety) continue;
         t.safety_active = true;
-        away -= ray_direction_world(in.ray_yaw_body_rad[k], in.q_world_body);
+        away -= direction(k);
       }
       if (t.safety_active) {
         // Hits on opposite sides cancel; then fall back on the graded reaction.
@@ -182,7 +206,7 @@ LawTerms frame_law(const LawInput& in, const Eigen::Vector3d& swarm, Eigen::Vect
           for (std::size_t k = 0; k < in.ray_range_m.size(); ++k) {
             const float r = in.ray_range_m[k];
             if (in.ray_hit[k] == 0 || std::isnan(r) || r >= safety) continue;
-            const Eigen::Vector3d d = ray_direction_world(in.ray_yaw_body_rad[k], in.q_world_body);
+            const Eigen::Vector3d d = direction(k);
             const double toward = other.dot(d);
             if (toward > 0) other -= toward * d;
           }

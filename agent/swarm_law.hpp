@@ -73,17 +73,31 @@ double sensor_activation(double range_m, bool hit, const SensorFunctionConfig& s
 /// Distance (m) at and beyond which f_s is 0 (fs1 4, fs2 6, log 6, custom: last S).
 double sensor_range_m(const SensorFunctionConfig& s);
 
-/// Unit horizontal world direction of a body-frame ray at yaw ray_yaw_body_rad;
-/// zero when the ray points straight up or down.
-Eigen::Vector3d ray_direction_world(double ray_yaw_body_rad,
-                                    const Eigen::Quaterniond& q_world_body);
+/// World direction of a body-frame ray at yaw ray_yaw_body_rad and elevation
+/// ray_elevation_body_rad (up from the body x-y plane): its heading h (the
+/// yaw turned with the attitude, projected on the horizontal plane and
+/// normalised) raised by its elevation, cos(e) h + sin(e) z. The body's tilt
+/// turns the heading only, so an elevation-0 ray (the thesis's ring) gives
+/// exactly the unit horizontal h. The horizontal part is zero when the
+/// heading points straight up or down.
+Eigen::Vector3d ray_direction_world(double ray_yaw_body_rad, const Eigen::Quaterniond& q_world_body,
+                                    double ray_elevation_body_rad = 0.0);
 
-/// C_s (m/s, world, z = 0): sum over rays k of f_s(S_k) * (-dir_k), where dir_k
-/// is the ray's direction in the world projected on the horizontal plane.
-/// The three spans are per ray; throws std::invalid_argument if their sizes differ.
+/// The weight of each ray in C_s: 1 / rows, rows = rays / (the rays at ray
+/// 0's elevation), so a scan of rows x columns (row by row, as the server
+/// casts it) sums over its columns and averages over its rows. 1 for the
+/// ring, or when ray_elevation_body_rad is empty.
+double ray_weight(std::span<const float> ray_elevation_body_rad);
+
+/// C_s (m/s, world): sum over rays k of w * f_s(S_k) * (-dir_k), with dir_k
+/// = ray_direction_world (yaw, attitude, elevation) and w = ray_weight, the
+/// thesis's Eq. 3.3 over the ring (z = 0 there) and a mean over rows for a
+/// pattern of several. The spans are per ray; ray_elevation_body_rad may be
+/// empty (every ray level). Throws std::invalid_argument if their sizes differ.
 Eigen::Vector3d obstacle_avoidance(std::span<const float> range_m,
                                    std::span<const std::uint8_t> hit,
                                    std::span<const float> ray_yaw_body_rad,
+                                   std::span<const float> ray_elevation_body_rad,
                                    const Eigen::Quaterniond& q_world_body,
                                    const SensorFunctionConfig& s);
 
@@ -94,8 +108,10 @@ struct LawInput {
   Eigen::Quaterniond q_world_body = Eigen::Quaterniond::Identity();  ///< own attitude
   std::span<const Eigen::Vector3d> peers_world;  ///< m, the other drones (self excluded)
   std::span<const float> ray_range_m;            ///< m, per ray
-  std::span<const std::uint8_t> ray_hit;      ///< per ray, nonzero = obstacle within sensor range
-  std::span<const float> ray_yaw_body_rad;    ///< rad, per ray
+  std::span<const std::uint8_t> ray_hit;    ///< per ray, nonzero = obstacle within sensor range
+  std::span<const float> ray_yaw_body_rad;  ///< rad, per ray
+  /// rad, per ray, up from the body x-y plane; empty: every ray level (the ring)
+  std::span<const float> ray_elevation_body_rad;
   Eigen::Vector3d mission_velocity{0, 0, 0};  ///< m/s, world (MissionOutput)
   double inter_distance_m = 4.0;              ///< m, D_int in force now
   bool swarm_enabled = true;                  ///< include C

@@ -339,14 +339,14 @@ TEST(ObstacleAvoidance, CentredBetweenEqualPillarsGetsNoSidewaysPush) {
   const Vector3d centre(0, 0, 2);
   Scan sc = scan(centre, q, pillars);
   ASSERT_GE(std::count(sc.hit.begin(), sc.hit.end(), 1), 2);
-  const Vector3d c = obstacle_avoidance(sc.range, sc.hit, sc.yaw, q, s);
+  const Vector3d c = obstacle_avoidance(sc.range, sc.hit, sc.yaw, {}, q, s);
   EXPECT_NEAR(c.x(), 0.0, 1e-6);
   EXPECT_NEAR(c.z(), 0.0, 1e-12);
 
   for (double off : {0.5, 1.0, 1.5}) {
     const Vector3d p(off, -0.3, 2);  // closer to the east pillar
     Scan so = scan(p, q, pillars);
-    const Vector3d push = obstacle_avoidance(so.range, so.hit, so.yaw, q, s);
+    const Vector3d push = obstacle_avoidance(so.range, so.hit, so.yaw, {}, q, s);
     EXPECT_LT(push.x(), -0.1) << "pushed back toward the middle at offset " << off;
   }
 }
@@ -358,19 +358,83 @@ TEST(ObstacleAvoidance, PushesAwayAlongTheWorldRayAndIgnoresFarOrMissedRays) {
   // Ray 0 (ahead = north) hits at 2.5 m: push south at 1 m/s. Ray 1 missed.
   std::vector<float> range = {2.5f, 1.0f};
   std::vector<std::uint8_t> hit = {1, 0};
-  Vector3d c = obstacle_avoidance(range, hit, yaw_body, q, s);
+  Vector3d c = obstacle_avoidance(range, hit, yaw_body, {}, q, s);
   EXPECT_NEAR((c - Vector3d(0, -1, 0)).norm(), 0.0, 1e-6);
   range = {4.5f, 1.0f};  // beyond fs1's 4 m
-  EXPECT_EQ(obstacle_avoidance(range, hit, yaw_body, q, s), Vector3d::Zero());
+  EXPECT_EQ(obstacle_avoidance(range, hit, yaw_body, {}, q, s), Vector3d::Zero());
   // Pitched attitude: the reaction stays horizontal.
   const Eigen::Quaterniond pitched =
       q * Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Vector3d::UnitY()));
   range = {2.5f, 1.0f};
-  c = obstacle_avoidance(range, hit, yaw_body, pitched, s);
+  c = obstacle_avoidance(range, hit, yaw_body, {}, pitched, s);
   EXPECT_EQ(c.z(), 0.0);
   EXPECT_NEAR(c.norm(), 1.0, 1e-6);
   hit.push_back(1);
-  EXPECT_THROW(obstacle_avoidance(range, hit, yaw_body, q, s), std::invalid_argument);
+  EXPECT_THROW(obstacle_avoidance(range, hit, yaw_body, {}, q, s), std::invalid_argument);
+}
+
+TEST(ObstacleAvoidance, SeveralRowsAreAveragedSoAWallSeenByAllPushesAsTheRing) {
+  SensorFunctionConfig s;  // fs1: 1 m/s at 2.5 m
+  const auto q = yaw(0);
+  // Three rows (-20, 0, +20 deg) of one column, looking east at a wall the
+  // drone's level ray meets at 2.5 m; each row reads the wall along its slant.
+  const float e = static_cast<float>(20 * kPi / 180);
+  const std::vector<float> yaw_body(3, 0.0f), elevation = {-e, 0.0f, e};
+  const std::vector<std::uint8_t> hit = {1, 1, 1};
+  const std::vector<float> range(3, 2.5f);  // as if every row read 2.5 m
+  const Vector3d c = obstacle_avoidance(range, hit, yaw_body, elevation, q, s);
+  // The mean over rows: f = 1 m/s for each, directions (cos e, 0, -+sin e) and
+  // (1, 0, 0); the vertical parts cancel.
+  EXPECT_NEAR(c.x(), -(1 + 2 * std::cos(20 * kPi / 180)) / 3, 1e-6);
+  EXPECT_NEAR(c.z(), 0.0, 1e-9);
+  // The ring's one ray at 2.5 m pushes 1 m/s: the rows push no harder than it.
+  const std::vector<float> one_yaw = {0.0f}, one_range = {2.5f};
+  const std::vector<std::uint8_t> one_hit = {1};
+  EXPECT_NEAR(obstacle_avoidance(one_range, one_hit, one_yaw, {}, q, s).x(), -1.0, 1e-6);
+  EXPECT_GT(-c.x(), 0.9);
+
+  // Only the top row sees something (an overhang): pushed back and down, by a
+  // third of its activation.
+  const std::vector<std::uint8_t> top = {0, 0, 1};
+  const Vector3d d = obstacle_avoidance(range, top, yaw_body, elevation, q, s);
+  EXPECT_NEAR(d.x(), -std::cos(20 * kPi / 180) / 3, 1e-6);
+  EXPECT_NEAR(d.z(), -std::sin(20 * kPi / 180) / 3, 1e-6);
+}
+
+TEST(ObstacleAvoidance, ARowPatternWeighsEachRayByOneOverItsRows) {
+  // 5 rows x 8 columns, row by row as the server casts them.
+  std::vector<float> elevation;
+  for (int r = 0; r < 5; ++r)
+    for (int c = 0; c < 8; ++c) elevation.push_back(static_cast<float>(0.1 * (r - 2)));
+  EXPECT_DOUBLE_EQ(ray_weight(elevation), 1.0 / 5);
+  EXPECT_EQ(ray_weight(std::vector<float>(8, 0.0f)), 1.0);  // the ring
+  EXPECT_EQ(ray_weight({}), 1.0);
+  // The ring's direction is unchanged by an elevation argument of 0, tilted or not.
+  const Eigen::Quaterniond tilted =
+      yaw(0.7) * Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Vector3d::UnitX()));
+  EXPECT_EQ(ray_direction_world(1.1, tilted, 0.0), ray_direction_world(1.1, tilted));
+  const Vector3d up = ray_direction_world(0.0, yaw(kPi / 2), 0.5);
+  EXPECT_NEAR((up - Vector3d(0, std::cos(0.5), std::sin(0.5))).norm(), 0.0, 1e-12);
+}
+
+TEST(ObstacleAvoidance, TheVerticalPushReachesTheCommandWithoutAltitudeHold) {
+  AgentConfig c;
+  LawInput in;
+  in.p_world = {0, 0, 2};
+  in.swarm_enabled = false;
+  in.altitude_hold = false;
+  const float e = static_cast<float>(20 * kPi / 180);
+  const std::vector<float> yaw_body(3, 0.0f), elevation = {-e, 0.0f, e}, range(3, 1.5f);
+  const std::vector<std::uint8_t> hit = {0, 0, 1};  // something ahead and above
+  in.ray_range_m = range;
+  in.ray_hit = hit;
+  in.ray_yaw_body_rad = yaw_body;
+  in.ray_elevation_body_rad = elevation;
+  const Vector3d v = control_velocity(in, c);
+  EXPECT_LT(v.x(), -0.05);
+  EXPECT_LT(v.z(), -0.05);  // pushed down, away from the overhang
+  in.altitude_hold = true;  // the altitude loop owns the vertical
+  EXPECT_NEAR(control_velocity(in, c).z(), 0.0, 1e-9);
 }
 
 // ---- the combined law ------------------------------------------------------------------------

@@ -50,6 +50,7 @@ msg::SwarmState make_state(int n) {
     sc.max_range_m(6.0f);
     for (int k = 0; k < kRays; ++k) {
       sc.angle_body_rad().push_back(static_cast<float>(2 * M_PI * k / kRays));
+      sc.elevation_body_rad().push_back(0.0f);
       sc.range_m().push_back(6.0f);
       sc.hit().push_back(0);
     }

@@ -30,6 +30,7 @@ inline msg::SwarmState bench_swarm(int n, int rays) {
     sc.drone_id(i);
     for (int k = 0; k < rays; ++k) {
       sc.angle_body_rad().push_back(static_cast<float>(k * 2 * M_PI / rays));
+      sc.elevation_body_rad().push_back(0.0f);
       sc.range_m().push_back(static_cast<float>(3 + k % 5));
       sc.hit().push_back(k % 2);
     }

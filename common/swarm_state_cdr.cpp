@@ -4,6 +4,7 @@
 #include <fastcdr/FastBuffer.h>
 
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <type_traits>
 
@@ -126,14 +127,22 @@ void read_sequence(CdrIn& in, std::vector<T>& v, std::uint32_t bound) {
   in.get_array(v.data(), v.size());
 }
 
-void read(CdrIn& in, msg::DistanceScan& s) {
+void read(CdrIn& in, msg::DistanceScan& s, ScanLayout layout) {
   in.get(s.drone_id());
   in.get(s.tick());
   in.get(s.sim_time_s());
   in.get(s.max_range_m());
-  read_sequence(in, s.angle_body_rad(), 64);
-  read_sequence(in, s.range_m(), 64);
-  read_sequence(in, s.hit(), 64);
+  if (layout == ScanLayout::kRing64) {
+    read_sequence(in, s.angle_body_rad(), 64);
+    s.elevation_body_rad().assign(s.angle_body_rad().size(), 0.0f);
+    read_sequence(in, s.range_m(), 64);
+    read_sequence(in, s.hit(), 64);
+    return;
+  }
+  read_sequence(in, s.angle_body_rad(), 256);
+  read_sequence(in, s.elevation_body_rad(), 256);
+  read_sequence(in, s.range_m(), 256);
+  read_sequence(in, s.hit(), 256);
 }
 
 void read(CdrIn& in, msg::MissionCommand& c) {
@@ -160,35 +169,74 @@ void read(CdrIn& in, msg::Beacon& b) {
   read(in, b.true_position());
 }
 
-template <class T>
-void read_structs(CdrIn& in, std::vector<T>& v, std::uint32_t bound) {
+template <class T, class... Layout>
+void read_structs(CdrIn& in, std::vector<T>& v, std::uint32_t bound, Layout... layout) {
   v.resize(in.length(bound));
   for (auto& e : v) {
     if (!in.ok()) return;
-    read(in, e);
+    read(in, e, layout...);
   }
 }
 
-}  // namespace
-
-bool decode_swarm_state(const std::uint8_t* data, std::size_t size, msg::SwarmState& out) {
+/// The encapsulation header's byte order, or false for a header Fast CDR refuses.
+bool encapsulation(const std::uint8_t* data, std::size_t size, bool& swap) {
   if (size < 4) return false;
   // Encapsulation: byte 0 is zero; byte 1 bit 0 is the byte order (1: little
   // endian), bit 1 the parameter-list flag. Fast CDR refuses anything else
   // there, and reads and ignores the options (bytes 2-3).
   if (data[0] != 0 || (data[1] & ~0x3) != 0) return false;
   const bool little = (data[1] & 0x1) != 0;
-  CdrIn in(data + 4, size - 4, little != (std::endian::native == std::endian::little));
+  swap = little != (std::endian::native == std::endian::little);
+  return true;
+}
+
+}  // namespace
+
+bool decode_swarm_state(const std::uint8_t* data, std::size_t size, msg::SwarmState& out,
+                        ScanLayout layout) {
+  bool swap = false;
+  if (!encapsulation(data, size, swap)) return false;
+  CdrIn in(data + 4, size - 4, swap);
   in.get(out.tick());
   in.get(out.sim_time_s());
   read_structs(in, out.drones(), 1024);
-  read_structs(in, out.scans(), 1024);
+  read_structs(in, out.scans(), 1024, layout);
   read_structs(in, out.recent_commands(), 8);
   read_structs(in, out.beacons(), 1024);
   return in.ok();
 }
 
-std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian) {
+bool decode_distance_scan(const std::uint8_t* data, std::size_t size, msg::DistanceScan& out,
+                          ScanLayout layout) {
+  bool swap = false;
+  if (!encapsulation(data, size, swap)) return false;
+  CdrIn in(data + 4, size - 4, swap);
+  read(in, out, layout);
+  return in.ok();
+}
+
+ScanLayout scan_layout_of(std::string_view schema_idl) {
+  const auto at = schema_idl.find("struct DistanceScan");
+  if (at == std::string_view::npos) return ScanLayout::kCurrent;
+  const std::string_view body = schema_idl.substr(at, schema_idl.find("};", at) - at);
+  return body.find("elevation_body_rad;") == std::string_view::npos ? ScanLayout::kRing64
+                                                                    : ScanLayout::kCurrent;
+}
+
+std::string scan_problem(const msg::DistanceScan& s) {
+  const std::size_t n = s.range_m().size();
+  if (s.angle_body_rad().size() != n || s.elevation_body_rad().size() != n || s.hit().size() != n)
+    return "its sequences differ in length (yaw " + std::to_string(s.angle_body_rad().size()) +
+           ", elevation " + std::to_string(s.elevation_body_rad().size()) + ", range " +
+           std::to_string(n) + ", hit " + std::to_string(s.hit().size()) + ")";
+  for (std::size_t k = 0; k < n; ++k)
+    if (!std::isfinite(s.angle_body_rad()[k]) || !std::isfinite(s.elevation_body_rad()[k]))
+      return "ray " + std::to_string(k) + "'s direction is not finite";
+  return {};
+}
+
+std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian,
+                                             ScanLayout layout) {
   msg::SwarmStatePubSubType type;
   eprosima::fastrtps::rtps::SerializedPayload_t p(
       type.getSerializedSizeProvider(const_cast<msg::SwarmState*>(&s))());
@@ -198,7 +246,20 @@ std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_
                                         : eprosima::fastcdr::Cdr::LITTLE_ENDIANNESS,
                              eprosima::fastcdr::Cdr::DDS_CDR);
   cdr.serialize_encapsulation();
-  s.serialize(cdr);
+  if (layout == ScanLayout::kCurrent) {
+    s.serialize(cdr);
+  } else {  // SwarmState.idl's order, each scan without its elevations
+    cdr << s.tick() << s.sim_time_s() << static_cast<std::uint32_t>(s.drones().size());
+    for (const auto& d : s.drones()) d.serialize(cdr);
+    cdr << static_cast<std::uint32_t>(s.scans().size());
+    for (const auto& sc : s.scans())
+      cdr << sc.drone_id() << sc.tick() << sc.sim_time_s() << sc.max_range_m()
+          << sc.angle_body_rad() << sc.range_m() << sc.hit();
+    cdr << static_cast<std::uint32_t>(s.recent_commands().size());
+    for (const auto& c : s.recent_commands()) c.serialize(cdr);
+    cdr << static_cast<std::uint32_t>(s.beacons().size());
+    for (const auto& b : s.beacons()) b.serialize(cdr);
+  }
   return {p.data, p.data + cdr.getSerializedDataLength()};
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "common/topics.hpp"
+#include "ddswarm_idl_text.hpp"
 
 using namespace ddswarm;
 using Payload = eprosima::fastrtps::rtps::SerializedPayload_t;
@@ -91,9 +92,12 @@ msg::SwarmState random_state(std::mt19937& rng, int drones) {
     sc.tick(rng());
     sc.sim_time_s(value());
     sc.max_range_m(static_cast<float>(value()));
-    const int rays = static_cast<int>(rng() % 65);
+    const int rays = static_cast<int>(rng() % 257);
+    // On the wire the sequences' lengths are independent: sometimes one is short.
+    const int elevations = rng() % 8 == 0 ? static_cast<int>(rng() % (rays + 1)) : rays;
     for (int k = 0; k < rays; ++k) {
       sc.angle_body_rad().push_back(static_cast<float>(value()));
+      if (k < elevations) sc.elevation_body_rad().push_back(static_cast<float>(value()));
       sc.range_m().push_back(static_cast<float>(value()));
       sc.hit().push_back(static_cast<std::uint8_t>(byte(rng)));
     }
@@ -236,4 +240,101 @@ TEST(SwarmStateCdr, TheTopicsTypeSupportCountsWhatItRefuses) {
   p.length = static_cast<std::uint32_t>(bytes.size() / 2);
   EXPECT_FALSE(support.deserialize(&p, &out));
   EXPECT_EQ(malformed_samples().load(), before + 1);
+}
+
+TEST(SwarmStateCdr, AFullScanOf256RaysRoundTripsAndA257thIsRefused) {
+  msg::SwarmState s;
+  s.tick(42);
+  msg::DistanceScan sc;
+  sc.drone_id(0);
+  sc.max_range_m(6);
+  for (int k = 0; k < 256; ++k) {  // 8 rows of 32, as the server lays them out
+    sc.angle_body_rad().push_back(static_cast<float>(2 * M_PI * (k % 32) / 32));
+    sc.elevation_body_rad().push_back(static_cast<float>(0.1 * (k / 32) - 0.35));
+    sc.range_m().push_back(static_cast<float>(0.5 + 0.01 * k));
+    sc.hit().push_back(static_cast<std::uint8_t>(k % 2));
+  }
+  s.scans().push_back(sc);
+  s.drones().resize(1);
+  const auto decoded = inline_decoded(encode_swarm_state(s));
+  ASSERT_TRUE(decoded.has_value());
+  const auto& d = decoded->scans().at(0);
+  ASSERT_EQ(d.elevation_body_rad().size(), 256u);
+  EXPECT_EQ(d.elevation_body_rad(), sc.elevation_body_rad());
+  EXPECT_EQ(d.angle_body_rad(), sc.angle_body_rad());
+  EXPECT_EQ(d.range_m(), sc.range_m());
+  EXPECT_EQ(d.hit(), sc.hit());
+  EXPECT_EQ(scan_problem(d), "");
+  s.scans()[0].elevation_body_rad().push_back(0);  // sequence<float, 256>
+  EXPECT_FALSE(inline_decoded(encode_swarm_state(s)).has_value());
+}
+
+// docs/configuration.md's figures: what every drone adds to each tick's SwarmState.
+TEST(SwarmStateCdr, EachDroneAddsItsStateAndItsScanOfThirteenBytesARay) {
+  auto size = [](int drones, int rays) {
+    msg::SwarmState s;
+    for (int i = 0; i < drones; ++i) {
+      msg::DroneState d;
+      d.drone_id(static_cast<std::uint16_t>(i));
+      s.drones().push_back(d);
+      msg::DistanceScan sc;
+      sc.drone_id(static_cast<std::uint16_t>(i));
+      sc.angle_body_rad().assign(rays, 0);
+      sc.elevation_body_rad().assign(rays, 0);
+      sc.range_m().assign(rays, 0);
+      sc.hit().assign(rays, 0);
+      s.scans().push_back(sc);
+    }
+    return static_cast<double>(encode_swarm_state(s).size());
+  };
+  // Give or take a byte of alignment padding.
+  EXPECT_NEAR((size(64, 0) - size(0, 0)) / 64, 156.0 + 44, 1);  // a state, and an empty scan
+  EXPECT_NEAR((size(64, 8) - size(0, 8)) / 64, 304.0, 1);       // the ring
+  EXPECT_NEAR((size(64, 40) - size(0, 40)) / 64, 720.0, 1);     // 5 rows x 8
+  EXPECT_NEAR((size(64, 256) - size(0, 256)) / 64, 3528.0, 1);
+}
+
+TEST(SwarmStateCdr, AMalformedScanIsNamed) {
+  msg::DistanceScan sc;
+  for (int k = 0; k < 4; ++k) {
+    sc.angle_body_rad().push_back(0);
+    sc.elevation_body_rad().push_back(0);
+    sc.range_m().push_back(1);
+    sc.hit().push_back(1);
+  }
+  EXPECT_EQ(scan_problem(sc), "");
+  msg::DistanceScan short_elevation = sc;
+  short_elevation.elevation_body_rad().pop_back();
+  EXPECT_EQ(scan_problem(short_elevation),
+            "its sequences differ in length (yaw 4, elevation 3, range 4, hit 4)");
+  msg::DistanceScan nan_elevation = sc;
+  nan_elevation.elevation_body_rad()[2] = NAN;
+  EXPECT_EQ(scan_problem(nan_elevation), "ray 2's direction is not finite");
+}
+
+TEST(SwarmStateCdr, ARecordingFromBeforeElevationsReadsAsALevelRing) {
+  std::mt19937 rng(17);
+  msg::SwarmState s = random_state(rng, 3);
+  for (auto& sc : s.scans()) {
+    sc.angle_body_rad().resize(std::min<std::size_t>(sc.angle_body_rad().size(), 64));
+    sc.range_m().resize(sc.angle_body_rad().size());
+    sc.hit().resize(sc.angle_body_rad().size());
+    sc.elevation_body_rad().clear();
+  }
+  const auto old = encode_swarm_state(s, false, ScanLayout::kRing64);
+  msg::SwarmState out;
+  EXPECT_FALSE(decode_swarm_state(old.data(), old.size(), out))
+      << "the old layout read as the new one";
+  ASSERT_TRUE(decode_swarm_state(old.data(), old.size(), out, ScanLayout::kRing64));
+  ASSERT_EQ(out.scans().size(), s.scans().size());
+  for (std::size_t i = 0; i < s.scans().size(); ++i) {
+    EXPECT_EQ(out.scans()[i].range_m(), s.scans()[i].range_m());
+    EXPECT_EQ(out.scans()[i].elevation_body_rad(),
+              std::vector<float>(s.scans()[i].range_m().size(), 0.0f));
+  }
+  // Which layout a recording has, its schema (the IDL text it was written with) says.
+  EXPECT_EQ(scan_layout_of(kIdlText), ScanLayout::kCurrent);
+  EXPECT_EQ(scan_layout_of("struct DistanceScan {\n  sequence<float, 64> angle_body_rad;\n};"),
+            ScanLayout::kRing64);
+  EXPECT_EQ(scan_layout_of(""), ScanLayout::kCurrent);
 }

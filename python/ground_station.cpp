@@ -25,6 +25,7 @@
 #include "common/config_error.hpp"
 #include "common/mission.hpp"
 #include "common/process.hpp"
+#include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
 #include "ground_station/dds_commander.hpp"
 #include "ground_station/gs_app.hpp"
@@ -113,17 +114,18 @@ py::dict state_to_python(const msg::SwarmState& s) {
     q[0] = x.orientation().w(), q[1] = x.orientation().x(), q[2] = x.orientation().y(),
     q[3] = x.orientation().z();
   }
-  // Scans by drone id (index = drone id), padded with NaN to the most rays.
+  // Scans by drone id (index = drone id), padded with NaN to the most rays;
+  // a malformed scan (scan_problem) is all NaN.
   std::size_t rays = 0;
   for (const auto& sc : s.scans()) rays = std::max(rays, sc.range_m().size());
-  auto ranges = nan_array(n, rays), angles = nan_array(n, rays);
+  auto ranges = nan_array(n, rays), angles = nan_array(n, rays), elevations = nan_array(n, rays);
   for (const auto& sc : s.scans()) {
     const std::size_t k = sc.drone_id();
-    if (k >= n) continue;
+    if (k >= n || !scan_problem(sc).empty()) continue;
     for (std::size_t r = 0; r < sc.range_m().size(); ++r) {
       ranges.mutable_data()[k * rays + r] = sc.range_m()[r];
-      if (r < sc.angle_body_rad().size())
-        angles.mutable_data()[k * rays + r] = sc.angle_body_rad()[r];
+      angles.mutable_data()[k * rays + r] = sc.angle_body_rad()[r];
+      elevations.mutable_data()[k * rays + r] = sc.elevation_body_rad()[r];
     }
   }
   d["ids"] = ids;
@@ -135,6 +137,7 @@ py::dict state_to_python(const msg::SwarmState& s) {
   d["phase_names"] = phase_names;
   d["scan_ranges"] = ranges;
   d["scan_angles"] = angles;
+  d["scan_elevations"] = elevations;
   return d;
 }
 

@@ -217,11 +217,14 @@ class Columns {
   std::vector<Column> columns_;
 };
 
-/// Deserialises one recorded CDR payload (encapsulation header included).
+/// Deserialises one recorded CDR payload (encapsulation header included);
+/// scans as the recording's schema lays them out (scan_layout_of).
 template <class T>
-bool from_cdr(std::span<const std::uint8_t> bytes, T& sample) {
+bool from_cdr(std::span<const std::uint8_t> bytes, T& sample, ScanLayout layout) {
   if constexpr (std::is_same_v<T, msg::SwarmState>) {
-    return decode_swarm_state(bytes.data(), bytes.size(), sample);
+    return decode_swarm_state(bytes.data(), bytes.size(), sample, layout);
+  } else if constexpr (std::is_same_v<T, msg::DistanceScan>) {
+    return decode_distance_scan(bytes.data(), bytes.size(), sample, layout);
   } else {
     typename Topic<T>::PubSub type;
     eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
@@ -275,8 +278,13 @@ py::dict recording_info(const std::string& path) {
 py::dict read_topic(const std::string& path, const std::string& topic) {
   auto r = open(path);
   std::vector<std::uint16_t> ids;
+  std::map<std::uint16_t, ScanLayout> layout;
   for (const auto& [id, ch] : r->channels())
-    if (ch.topic == topic) ids.push_back(id);
+    if (ch.topic == topic) {
+      ids.push_back(id);
+      const auto schema = r->schemas().find(ch.schema_id);
+      layout[id] = scan_layout_of(schema == r->schemas().end() ? "" : schema->second.data);
+    }
   if (ids.empty()) throw py::key_error(path + ": no topic '" + topic + "' in this recording");
   py::dict out;
   bool known = false;
@@ -294,7 +302,7 @@ py::dict read_topic(const std::string& path, const std::string& topic) {
       r->for_each_message([&](const mcap::MessageView& m) {
         if (std::find(ids.begin(), ids.end(), m.channel_id) == ids.end()) return;
         T sample;
-        if (!from_cdr(m.data, sample)) {
+        if (!from_cdr(m.data, sample, layout[m.channel_id])) {
           if (!fill) ++rejected;
           return;
         }

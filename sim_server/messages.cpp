@@ -34,7 +34,7 @@ msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim,
   for (const auto& p : starts) s.start_positions().push_back(to_msg(p));
   s.drone_radius_m(quadrotor.collision_radius_m);
   s.arm_length_m(quadrotor.arm_length_m);
-  s.sensor_count(static_cast<std::uint16_t>(sensors.count));
+  s.sensor_count(static_cast<std::uint16_t>(sensors.rays()));
   s.sensor_max_range_m(static_cast<float>(sensors.max_range_m));
   return s;
 }
@@ -61,9 +61,10 @@ msg::SwarmState swarm_state_frame(int n, const SensorConfig& sensors) {
     auto& sc = m.scans()[i];
     sc.drone_id(static_cast<std::uint16_t>(i));
     sc.max_range_m(static_cast<float>(sensors.max_range_m));
-    for (int k = 0; k < sensors.count; ++k)
-      sc.angle_body_rad().push_back(
-          static_cast<float>(sensors.yaw_offset_rad + 2.0 * M_PI * k / sensors.count));
+    for (int k = 0; k < sensors.rays(); ++k) {
+      sc.angle_body_rad().push_back(static_cast<float>(sensors.ray_yaw_rad(k)));
+      sc.elevation_body_rad().push_back(static_cast<float>(sensors.ray_elevation_rad(k)));
+    }
   }
   return m;
 }

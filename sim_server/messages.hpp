@@ -49,7 +49,8 @@ msg::Scene scene_message(const ScenarioConfig& scenario, const SimConfig& sim,
 msg::SceneWind scene_wind(const WindConfig& wind);
 
 /// A SwarmState for n drones with what never changes filled in: each scan's
-/// drone id, max range and ray angles (rad, body frame, +CCW).
+/// drone id, max range and each ray's body yaw (rad, +CCW about body z) and
+/// elevation (rad, up from the body x-y plane), in SensorConfig's ray order.
 msg::SwarmState swarm_state_frame(int n, const SensorConfig& sensors);
 
 /// One drone at one tick, as its DroneState tells it.

@@ -122,6 +122,26 @@ TEST(Messages, TheSwarmFrameCarriesEachScansRays) {
   EXPECT_EQ(m.scans()[1].drone_id(), 1);
   ASSERT_EQ(m.scans()[1].angle_body_rad().size(), 4u);
   EXPECT_FLOAT_EQ(m.scans()[1].angle_body_rad()[1], static_cast<float>(M_PI / 2));
+  ASSERT_EQ(m.scans()[1].elevation_body_rad().size(), 4u);
+  EXPECT_EQ(m.scans()[1].elevation_body_rad()[3], 0.0f);  // the ring lies in the body x-y plane
+}
+
+TEST(Messages, ARowPatternCarriesEachRaysYawAndElevationRowByRow) {
+  SensorConfig sensors;
+  sensors.count = 4;
+  sensors.rows = 3;
+  sensors.vertical_fov_deg = 40;
+  const auto m = swarm_state_frame(1, sensors);
+  const auto& sc = m.scans()[0];
+  ASSERT_EQ(sc.angle_body_rad().size(), 12u);
+  ASSERT_EQ(sc.elevation_body_rad().size(), 12u);
+  // Ray 6 = row 1 (the middle, level), column 2 (behind).
+  EXPECT_FLOAT_EQ(sc.angle_body_rad()[6], static_cast<float>(M_PI));
+  EXPECT_EQ(sc.elevation_body_rad()[6], 0.0f);
+  EXPECT_FLOAT_EQ(sc.elevation_body_rad()[0], static_cast<float>(-20 * M_PI / 180));
+  EXPECT_FLOAT_EQ(sc.elevation_body_rad()[11], static_cast<float>(20 * M_PI / 180));
+  const auto s = scene_message({}, {}, {}, {}, sensors, {}, 0);
+  EXPECT_EQ(s.sensor_count(), 12);  // rays per scan
 }
 
 TEST(Messages, ADroneContactCountsOnBothDrones) {

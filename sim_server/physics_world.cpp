@@ -694,7 +694,7 @@ double PhysicsWorld::ray_distance(const RayTarget& t, const Eigen::Vector3d& o,
 
 void PhysicsWorld::cast_rays(int drone, const SensorConfig& cfg, std::mt19937_64& rng,
                              std::vector<float>& range_m, std::vector<std::uint8_t>& hit) const {
-  const int n = std::clamp(cfg.count, 0, 64);
+  const int n = std::clamp(cfg.rays(), 0, SensorConfig::kMaxRays);
   const double max_range = cfg.max_range_m;
   range_m.assign(n, static_cast<float>(max_range));
   hit.assign(n, 0);
@@ -703,12 +703,9 @@ void PhysicsWorld::cast_rays(int drone, const SensorConfig& cfg, std::mt19937_64
   const btTransform& body_t = self->getWorldTransform();
   const Eigen::Vector3d origin = to_eigen(body_t.getOrigin());
   const Eigen::Matrix3d rot = to_eigen(body_t.getBasis());
-  std::array<Eigen::Vector3d, 64> dir;
-  for (int k = 0; k < n; ++k) {
-    const double a = cfg.yaw_offset_rad + 2 * std::numbers::pi * k / n;
-    dir[k] = rot * Eigen::Vector3d(std::cos(a), std::sin(a), 0.0);
-  }
-  std::array<double, 64> dist;
+  std::array<Eigen::Vector3d, SensorConfig::kMaxRays> dir;
+  for (int k = 0; k < n; ++k) dir[k] = rot * cfg.ray_direction_body(k);
+  std::array<double, SensorConfig::kMaxRays> dist;
   dist.fill(kInf);
 
   if (ray_mode_ == RayCastMode::kWorldRayTest) {

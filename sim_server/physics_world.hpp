@@ -131,11 +131,11 @@ class PhysicsWorld {
   /// True while the drone touches the ground plane (as of the last step).
   bool touching_ground(int drone) const { return touching_ground_[drone] != 0; }
 
-  /// Casts the drone's distance sensors from its body centre. Ray k points at
-  /// body yaw cfg.yaw_offset_rad + 2 pi k / cfg.count in the body x-y plane,
-  /// turned with the full body attitude. A ray never hits its own drone; it
+  /// Casts the drone's distance sensors from its body centre. Ray k points
+  /// along cfg.ray_direction_body(k) (body yaw of its column, elevation of its
+  /// row), turned with the full body attitude. A ray never hits its own drone; it
   /// hits other drones, obstacles and the ground. On return both vectors have
-  /// cfg.count entries: hit[k] = 1 and range_m[k] = true distance + N(0,
+  /// cfg.rays() entries: hit[k] = 1 and range_m[k] = true distance + N(0,
   /// sigma) clamped to [min_range_m, max_range_m] when something is within
   /// max_range_m; otherwise hit[k] = 0 and range_m[k] = max_range_m. A ray
   /// starting inside an object measures 0 (then min_range_m). Noise is drawn

@@ -434,6 +434,50 @@ TEST(RaySensors, RotateWithTheBody) {
   EXPECT_NEAR(range[0], 1.5, 1e-4);
 }
 
+// A wall 3 m east (x = 3 to 3.3, y = -5 to 5, 6 m tall) with a window 4 m
+// wide from 1.5 m to 2.5 m: the boxes on either side, below and above it.
+SceneConfig window_wall() {
+  return scene_with(
+      {}, {Box{{3.15, -3.5, 3}, {0.3, 3, 6}, 0.0}, Box{{3.15, 3.5, 3}, {0.3, 3, 6}, 0.0},
+           Box{{3.15, 0, 0.75}, {0.3, 4, 1.5}, 0.0}, Box{{3.15, 0, 4.25}, {0.3, 4, 3.5}, 0.0}});
+}
+
+TEST(RaySensors, ThreeRowsSeeTheWallAboveAndBelowAWindowTheMiddleRowPassesThrough) {
+  PhysicsWorld w(window_wall(), QuadrotorParams{}, {{0, 0, 0}}, 0.0);
+  w.reset_drone(0, {0, 0, 2}, 0.0);  // level with the window's middle, facing it
+  std::mt19937_64 rng(1);
+  std::vector<float> range;
+  std::vector<std::uint8_t> hit;
+  SensorConfig c = exact_sensors();
+  c.rows = 3;
+  c.vertical_fov_deg = 40;  // rows at -20, 0, +20 deg
+  for (auto mode : {RayCastMode::kCulled, RayCastMode::kBruteForce, RayCastMode::kWorldRayTest}) {
+    w.set_ray_cast_mode(mode);
+    w.cast_rays(0, c, rng, range, hit);
+    ASSERT_EQ(range.size(), 24u);
+    // Column 0 (east) of each row: ray 0 (down 20 deg) meets the sill's face
+    // at z = 2 - 3 tan 20 = 0.91 m, ray 8 (level) flies through the window,
+    // ray 16 (up 20 deg) meets the lintel's face at z = 3.09 m; both 3/cos 20 away.
+    EXPECT_EQ(hit[0], 1);
+    EXPECT_NEAR(range[0], 3 / std::cos(20 * kPi / 180), 1e-4);
+    EXPECT_EQ(hit[8], 0);
+    EXPECT_EQ(range[8], 4.0f);
+    EXPECT_EQ(hit[16], 1);
+    EXPECT_NEAR(range[16], 3 / std::cos(20 * kPi / 180), 1e-4);
+  }
+  // The ring alone (one row, level) sees no wall at all.
+  w.set_ray_cast_mode(RayCastMode::kCulled);
+  w.cast_rays(0, exact_sensors(), rng, range, hit);
+  EXPECT_EQ(hit[0], 0);
+  // Turned to face north, the rows turn with the body: column 6 (body -90
+  // deg) now looks east, its middle ray (14) through the window.
+  w.reset_drone(0, {0, 0, 2}, kPi / 2);
+  w.cast_rays(0, c, rng, range, hit);
+  EXPECT_EQ(hit[6], 1);
+  EXPECT_EQ(hit[14], 0);
+  EXPECT_EQ(hit[22], 1);
+}
+
 TEST(RaySensors, NothingBeyondMaxRange) {
   PhysicsWorld w(scene_with({Cylinder{{5, 0}, 0.5, 6}}), QuadrotorParams{}, {{0, 0, 0}}, 0.0);
   w.reset_drone(0, {0, 0, 1}, 0.0);

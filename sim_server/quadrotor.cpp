@@ -192,6 +192,30 @@ void SensorConfig::validate() const {
   if (!(max_range_m > min_range_m))
     throw FieldError("sensors.max_range_m", to_text(max_range_m),
                      "must exceed min_range_m (" + to_text(min_range_m) + ")");
+  if (rows * count > kMaxRays)
+    throw FieldError("sensors.rows", to_text(rows),
+                     "rows x count = " + std::to_string(rows * count) + " rays: must be <= " +
+                         std::to_string(kMaxRays) + " (count " + std::to_string(count) + ")");
+  if (rows > 1 && !(vertical_fov_deg > 0))
+    throw FieldError("sensors.rows", to_text(rows),
+                     "needs vertical_fov_deg > 0 (with 0 every row looks the same way)");
+}
+
+double SensorConfig::ray_yaw_rad(int k) const {
+  return yaw_offset_rad + 2 * std::numbers::pi * (k % count) / count;
+}
+
+double SensorConfig::ray_elevation_rad(int k) const {
+  if (rows <= 1) return 0.0;
+  // Symmetric about 0 and exactly 0 for the middle row of an odd count.
+  const int r = k / count;
+  return vertical_fov_deg * (std::numbers::pi / 180) * (2 * r - (rows - 1)) / (2.0 * (rows - 1));
+}
+
+Eigen::Vector3d SensorConfig::ray_direction_body(int k) const {
+  const double a = ray_yaw_rad(k), e = ray_elevation_rad(k);
+  const double ce = std::cos(e);
+  return {ce * std::cos(a), ce * std::sin(a), std::sin(e)};
 }
 
 }  // namespace ddswarm::sim

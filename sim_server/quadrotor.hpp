@@ -181,25 +181,50 @@ struct QuadrotorParams {
 /// then every other key overrides it. Unknown keys throw ConfigError.
 void load(YamlSection s, QuadrotorParams& c);
 
-/// The ring of distance sensors on every drone (the thesis's 8 rangefinders).
+/// The distance sensors on every drone: by default the thesis's ring of 8
+/// rangefinders in the body x-y plane; with rows > 1, a lidar-like pattern of
+/// rows x count rays spread in elevation over vertical_fov_deg.
+///
+/// Ray k is row k / count, column k % count: body yaw yaw_offset_rad + 2 pi
+/// column / count, elevation (up from the body x-y plane) -fov/2 + fov row /
+/// (rows - 1), 0 with one row.
 struct SensorConfig {
-  int count = 8;                ///< rays, evenly spaced in the body x-y plane, in [1, 64]
+  /// At most this many rays per scan (DistanceScan's sequences): every
+  /// SwarmState carries every drone's scan, 9 bytes a ray.
+  static constexpr int kMaxRays = 256;
+
+  int count = 8;                ///< rays per row, evenly spaced in yaw, in [1, 256]
+  int rows = 1;                 ///< rows of rays, in [1, 32]; rows x count <= kMaxRays
+  double vertical_fov_deg = 0;  ///< deg, elevation from the lowest row to the highest, in [0, 180]
   double max_range_m = 4.0;     ///< m, > min_range_m
   double min_range_m = 0.05;    ///< m, > 0; measured ranges are clamped to it
   double noise_sigma_m = 0.02;  ///< m, Gaussian range noise standard deviation, >= 0
-  double yaw_offset_rad = 0.0;  ///< rad, body yaw of ray 0, in [-2pi, 2pi]
+  double yaw_offset_rad = 0.0;  ///< rad, body yaw of column 0, in [-2pi, 2pi]
 
   template <class Self, class V>
   static void fields(Self& c, V& v) {
-    v.field("count", c.count, {"", in(1, 64), "rays, evenly spaced in the body x-y plane"});
+    v.field("count", c.count, {"", in(1, kMaxRays), "rays per row, evenly spaced in body yaw"});
+    v.field("rows", c.rows,
+            {"", in(1, 32), "rows of rays, evenly spread in elevation over vertical_fov_deg"});
+    v.field("vertical_fov_deg", c.vertical_fov_deg,
+            {"deg", in(0, 180), "elevation from the lowest row to the highest"});
     v.field("max_range_m", c.max_range_m, {"m", positive(), "sensor range"});
     v.field("min_range_m", c.min_range_m, {"m", positive(), "readings are clamped up to this"});
     v.field("noise_sigma_m", c.noise_sigma_m,
             {"m", non_negative(), "Gaussian range noise, standard deviation"});
-    v.field(
-        "yaw_offset_rad", c.yaw_offset_rad,
-        {"rad", in(-2 * 3.14159265358979323846, 2 * 3.14159265358979323846), "body yaw of ray 0"});
+    v.field("yaw_offset_rad", c.yaw_offset_rad,
+            {"rad", in(-2 * 3.14159265358979323846, 2 * 3.14159265358979323846),
+             "body yaw of column 0"});
   }
+
+  /// Rays per scan: rows x count.
+  int rays() const { return rows * count; }
+  /// rad, body yaw of ray k (its column's).
+  double ray_yaw_rad(int k) const;
+  /// rad, elevation of ray k (its row's) up from the body x-y plane; 0 with one row.
+  double ray_elevation_rad(int k) const;
+  /// Unit direction of ray k in the body frame (FLU).
+  Eigen::Vector3d ray_direction_body(int k) const;
 
   void validate() const;  ///< throws FieldError("sensors.…")
 };

@@ -102,7 +102,7 @@ TEST(Validation, NamesTheBadField) {
   s.count = 0;
   EXPECT_EQ(field_error_of(s), "sensors.count");
   s = {};
-  s.count = 65;
+  s.count = 257;
   EXPECT_EQ(field_error_of(s), "sensors.count");
   s = {};
   s.max_range_m = 0.04;
@@ -110,6 +110,9 @@ TEST(Validation, NamesTheBadField) {
   s = {};
   s.noise_sigma_m = -0.1;
   EXPECT_EQ(field_error_of(s), "sensors.noise_sigma_m");
+  s = {};
+  s.count = 256;  // one row of 256 is the most a scan carries
+  EXPECT_NO_THROW(s.validate());
 
   ControllerConfig c;
   EXPECT_NO_THROW(c.validate());
@@ -203,6 +206,68 @@ TEST(Load, UnknownKeyIsAnError) {
   auto doc3 = YamlDocument::parse("controller:\n  max_sped_mps: 8\n", "t.yaml");
   ControllerConfig c;
   EXPECT_THROW(load(doc3.section("controller"), c), ConfigError);
+}
+
+TEST(Sensors, RowsSpreadEvenlyInElevationAndOneRowIsTheThesisRing) {
+  SensorConfig ring;
+  ASSERT_EQ(ring.rays(), 8);
+  for (int k = 0; k < 8; ++k) {
+    const double a = 2 * std::numbers::pi * k / 8;  // as the ring was always cast
+    EXPECT_EQ(ring.ray_direction_body(k), Eigen::Vector3d(std::cos(a), std::sin(a), 0.0)) << k;
+    EXPECT_EQ(ring.ray_elevation_rad(k), 0.0);
+  }
+  SensorConfig s;
+  s.rows = 5;
+  s.vertical_fov_deg = 40;
+  s.count = 8;
+  ASSERT_EQ(s.rays(), 40);
+  const double deg = std::numbers::pi / 180;
+  // Ray k = row k / 8, column k % 8; rows at -20, -10, 0, 10, 20 deg.
+  for (int r = 0; r < 5; ++r)
+    for (int c = 0; c < 8; ++c) {
+      const int k = r * 8 + c;
+      EXPECT_NEAR(s.ray_elevation_rad(k), (-20 + 10 * r) * deg, 1e-12) << k;
+      EXPECT_DOUBLE_EQ(s.ray_yaw_rad(k), 2 * std::numbers::pi * c / 8) << k;
+      const Eigen::Vector3d d = s.ray_direction_body(k);
+      EXPECT_NEAR(d.norm(), 1.0, 1e-12);
+      EXPECT_NEAR(std::asin(d.z()), s.ray_elevation_rad(k), 1e-12);
+      EXPECT_NEAR(std::atan2(d.y(), d.x()), std::remainder(s.ray_yaw_rad(k), 2 * std::numbers::pi),
+                  1e-12);
+    }
+  EXPECT_EQ(s.ray_elevation_rad(16), 0.0);  // the middle row is exactly level
+  EXPECT_EQ(s.ray_elevation_rad(0), -s.ray_elevation_rad(39));
+  // Two rows over 180 deg: straight down and straight up.
+  s.rows = 2;
+  s.vertical_fov_deg = 180;
+  EXPECT_NEAR(s.ray_direction_body(0).z(), -1.0, 1e-12);
+  EXPECT_NEAR(s.ray_direction_body(8).z(), 1.0, 1e-12);
+}
+
+TEST(Sensors, ABadRowPatternIsOneLineNamingTheFieldTheValueAndTheLine) {
+  auto error = [](const std::string& yaml) {
+    auto doc = YamlDocument::parse(yaml, "s.yaml");
+    SensorConfig s;
+    try {
+      doc.guard([&] {
+        load(doc.section("sensors"), s);
+        s.validate();
+      });
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error("sensors:\n  count: 8\n  rows: 0\n"),
+            "s.yaml:3: sensors.rows = 0: must be in [1, 32]");
+  EXPECT_EQ(error("sensors:\n  rows: 3\n  vertical_fov_deg: 200\n"),
+            "s.yaml:3: sensors.vertical_fov_deg = 200: must be in [0, 180]");
+  EXPECT_EQ(error("sensors:\n  count: 100\n  rows: 3\n  vertical_fov_deg: 30\n"),
+            "s.yaml:3: sensors.rows = 3: rows x count = 300 rays: must be <= 256 (count 100)");
+  EXPECT_EQ(error("sensors:\n  count: 8\n  rows: 3\n"),
+            "s.yaml:3: sensors.rows = 3: needs vertical_fov_deg > 0 (with 0 every row looks the "
+            "same way)");
+  EXPECT_EQ(error("sensors: {rows: 5, vertical_fov_deg: 40, count: 8}\n"), "accepted");
+  EXPECT_EQ(error("sensors: {rows: 32, vertical_fov_deg: 90, count: 8}\n"), "accepted");
 }
 
 TEST(Load, ValidationErrorGetsFileAndLine) {

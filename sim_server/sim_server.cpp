@@ -400,6 +400,10 @@ struct SimServer::Impl {
       spdlog::info("ddswarm-sim: {} mesh obstacle(s), {} triangles", cfg.scene.meshes.size(),
                    triangles);
     }
+    if (cfg.sensors.rows > 1)
+      spdlog::info("ddswarm-sim: sensors: {} rows of {} rays over {} deg of elevation ({} a scan)",
+                   cfg.sensors.rows, cfg.sensors.count, cfg.sensors.vertical_fov_deg,
+                   cfg.sensors.rays());
     if (cfg.wind.enabled())
       spdlog::info("ddswarm-sim: wind {:.1f} m/s{}{}", cfg.wind.steady_mps.norm(),
                    cfg.wind.turbulence ? ", Dryden turbulence" : "",

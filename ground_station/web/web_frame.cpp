@@ -8,6 +8,7 @@
 
 #include "common/convert.hpp"
 #include "common/mission.hpp"
+#include "common/swarm_state_cdr.hpp"
 
 namespace ddswarm::gs::web {
 
@@ -114,13 +115,12 @@ Frame to_frame(const msg::SwarmState& s) {
     o.col = {d.collisions_obstacle(), d.collisions_drone(), d.collisions_ground()};
   }
   for (const auto& sc : s.scans()) {
-    if (sc.drone_id() >= f.drones.size()) continue;
+    if (sc.drone_id() >= f.drones.size() || !scan_problem(sc).empty()) continue;
     auto& o = f.drones[sc.drone_id()];
-    const std::size_t n =
-        std::min({sc.angle_body_rad().size(), sc.range_m().size(), sc.hit().size()});
-    o.ray_angle.assign(sc.angle_body_rad().begin(), sc.angle_body_rad().begin() + n);
-    o.ray_range.assign(sc.range_m().begin(), sc.range_m().begin() + n);
-    o.ray_hit.assign(sc.hit().begin(), sc.hit().begin() + n);
+    o.ray_angle = sc.angle_body_rad();
+    o.ray_elevation = sc.elevation_body_rad();
+    o.ray_range = sc.range_m();
+    o.ray_hit = sc.hit();
   }
   return f;
 }
@@ -188,6 +188,11 @@ std::string encode_frame(const Frame& f, bool rays) {
       for (std::size_t k = 0; k < d.ray_angle.size(); ++k) {
         if (k) out += ',';
         put_num(out, d.ray_angle[k], 4);
+      }
+      out += R"(],"e":[)";
+      for (std::size_t k = 0; k < d.ray_elevation.size(); ++k) {
+        if (k) out += ',';
+        put_num(out, d.ray_elevation[k], 4);
       }
       out += R"(],"r":[)";
       for (std::size_t k = 0; k < d.ray_range.size(); ++k) {

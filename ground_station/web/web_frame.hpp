@@ -37,6 +37,7 @@ struct DroneFrame {
   std::uint8_t phase = 0;              ///< common/mission.hpp Phase
   std::array<std::uint32_t, 3> col{};  ///< contacts begun: obstacle, drone, ground
   std::vector<float> ray_angle;        ///< rad, body yaw of each ray (empty: no scan)
+  std::vector<float> ray_elevation;    ///< rad, elevation of each ray, up from the body x-y plane
   std::vector<float> ray_range;        ///< m, measured range
   std::vector<std::uint8_t> ray_hit;   ///< 1 if something is within range
 };
@@ -48,7 +49,9 @@ struct Frame {
   std::vector<DroneFrame> drones;  ///< index = drone id
 };
 
-/// The edge: a SwarmState (drones and their latest scans) as a Frame.
+/// The edge: a SwarmState (drones and their latest scans) as a Frame. A
+/// malformed scan (scan_problem: sequences of different lengths, a ray
+/// pointing nowhere) gives its drone no rays.
 Frame to_frame(const msg::SwarmState& s);
 
 /// For each position, the distance (m) to the nearest other one; NaN when it is alone.

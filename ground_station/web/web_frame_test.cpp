@@ -10,7 +10,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/mcap/mcap_writer.hpp"
 #include "common/mesh_loader.hpp"
+#include "common/swarm_state_cdr.hpp"
+#include "common/topics.hpp"
+#include "ddswarm_idl_text.hpp"
+#include "ground_station/web/web_recording.hpp"
 
 using namespace ddswarm;
 using namespace ddswarm::gs::web;
@@ -50,6 +55,7 @@ msg::SwarmState three_drones() {
   msg::DistanceScan sc;
   sc.drone_id(1);
   sc.angle_body_rad({0.f, 1.5707964f});
+  sc.elevation_body_rad({0.f, 0.3490659f});
   sc.range_m({2.5f, 8.f});
   sc.hit({1, 0});
   s.scans().push_back(sc);
@@ -85,6 +91,18 @@ TEST(WebFrame, RaysOnlyWhenAskedAndEmptyForADroneWithoutAScan) {
   EXPECT_EQ(j["rays"][1]["r"], json::array({2.5, 8}));
   EXPECT_EQ(j["rays"][1]["hit"], json::array({1, 0}));
   EXPECT_NEAR(j["rays"][1]["a"][1].get<double>(), 1.5708, 1e-9);
+  EXPECT_NEAR(j["rays"][1]["e"][1].get<double>(), 0.3491, 1e-9);  // rad, up from the body plane
+}
+
+TEST(WebFrame, AMalformedScanDrawsNoRays) {
+  auto s = three_drones();
+  s.scans()[0].elevation_body_rad().pop_back();  // one elevation short
+  auto j = json::parse(encode_frame(to_frame(s), true));
+  EXPECT_TRUE(j["rays"][1]["a"].empty());
+  s = three_drones();
+  s.scans()[0].elevation_body_rad()[0] = NAN;
+  j = json::parse(encode_frame(to_frame(s), true));
+  EXPECT_TRUE(j["rays"][1]["r"].empty());
 }
 
 TEST(WebFrame, PositionsKeepATenthOfAMillimetre) {
@@ -419,4 +437,36 @@ TEST(WebFrame, MeshFilesAreServedOnlyWithTheServersBytes) {
   EXPECT_EQ(j["wind"]["gusts_per_minute"], 2);
   EXPECT_EQ(j["wind"]["gust_max"], 3);
   fs::remove_all(dir);
+}
+
+// A recording made before scans carried elevations: its schema has no
+// DistanceScan.elevation_body_rad and its bytes none. The web view's replay
+// reads its frames, the rays level.
+TEST(WebRecording, ARecordingFromBeforeScanElevationsReplaysWithLevelRays) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("ddswarm_old_" + std::to_string(getpid()) + ".mcap"))
+                               .string();
+  std::string idl = kIdlText;
+  const auto at = idl.find("  sequence<float, 256> elevation_body_rad;");
+  ASSERT_NE(at, std::string::npos);
+  idl.erase(at, idl.find('\n', at) + 1 - at);
+  {
+    mcap::Writer w(path);
+    const auto ch = w.add_channel(w.add_schema("ddswarm::msg::SwarmState", "omgidl", idl),
+                                  Topic<msg::SwarmState>::name, "cdr");
+    for (int k = 0; k < 3; ++k) {
+      auto s = three_drones();
+      s.sim_time_s(1.0 + k);
+      const auto bytes = encode_swarm_state(s, false, ScanLayout::kRing64);
+      w.write(ch, 1'000'000'000ull * (k + 1), 1'000'000'000ull * (k + 1), bytes.data(),
+              bytes.size());
+    }
+    w.close();
+  }
+  const auto rec = load_recording(path, "old.mcap");
+  std::filesystem::remove(path);
+  ASSERT_EQ(rec->frames.size(), 3u);
+  const auto& d = rec->frames[2].drones[1];
+  EXPECT_EQ(d.ray_range, std::vector<float>({2.5f, 8.f}));
+  EXPECT_EQ(d.ray_elevation, std::vector<float>({0.f, 0.f}));
 }

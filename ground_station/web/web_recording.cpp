@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/mcap/mcap_reader.hpp"
+#include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
 
 namespace ddswarm::gs::web {
@@ -28,7 +29,7 @@ bool from_cdr(std::span<const std::uint8_t> bytes, T& sample) {
 
 std::uint64_t frame_bytes(const Frame& f) {
   std::uint64_t b = sizeof(Frame) + f.drones.size() * sizeof(DroneFrame);
-  for (const auto& d : f.drones) b += d.ray_angle.size() * 9;
+  for (const auto& d : f.drones) b += d.ray_angle.size() * 13;
   return b;
 }
 
@@ -46,7 +47,10 @@ std::shared_ptr<Recording> load_recording(const std::string& path, const std::st
                                           const RecordingLimits& limits) {
   mcap::Reader reader(path);
   std::map<std::uint16_t, Kind> kind;
+  std::map<std::uint16_t, ScanLayout> layout;  // a recording made before scans had elevations
   for (const auto& [id, ch] : reader.channels()) {
+    const auto schema = reader.schemas().find(ch.schema_id);
+    layout[id] = scan_layout_of(schema == reader.schemas().end() ? "" : schema->second.data);
     Kind k = Kind::kNone;
     if (ch.topic == Topic<msg::SwarmState>::name) k = Kind::kState;
     if (ch.topic == Topic<msg::Scene>::name) k = Kind::kScene;
@@ -75,7 +79,7 @@ std::shared_ptr<Recording> load_recording(const std::string& path, const std::st
       case Kind::kNone:
         return;
       case Kind::kState: {
-        if (!from_cdr(m.data, state)) {
+        if (!decode_swarm_state(m.data.data(), m.data.size(), state, layout[m.channel_id])) {
           ++undecodable;
           return;
         }

@@ -178,9 +178,10 @@ class GroundStation:
         """The latest swarm state as a Table of numpy arrays (N drones,
         by drone id): t (sim s), tick, ids, positions (N, 3; m, world ENU),
         velocities (N, 3; m/s), attitudes (N, 4; w x y z), flags, phases
-        (N,) and phase_names, scan_ranges and scan_angles (N, rays; m, rad
-        body yaw; NaN where a drone has fewer rays). TimeoutError when none
-        arrives within timeout s."""
+        (N,) and phase_names, scan_ranges, scan_angles and scan_elevations
+        (N, rays; m, rad body yaw, rad up from the body x-y plane; ray k is
+        row k // columns, column k % columns; NaN where a drone has fewer
+        rays). TimeoutError when none arrives within timeout s."""
         return Table(self._gs.state(float(timeout)))
 
     def states(self, hz=None, timeout=5.0, count=None):

@@ -55,12 +55,16 @@ class Recording:
         """The swarm state (ddswarm/swarm_state), with short names added:
         t (sim time, s), tick, positions and velocities (T, N, 3, m and m/s,
         world ENU), attitudes (T, N, 4, w x y z), flags and phases (T, N),
-        scan_ranges (T, N, rays, m)."""
+        scan_ranges (T, N, rays, m), scan_angles and scan_elevations (T, N,
+        rays; rad body yaw, rad up from the body x-y plane; 0 in recordings
+        made before scans carried elevations)."""
         s = self.topic("ddswarm/swarm_state")
         for short, field in (("t", "sim_time_s"), ("positions", "drones.position"),
                              ("velocities", "drones.velocity"), ("attitudes", "drones.orientation"),
                              ("flags", "drones.flags"), ("phases", "drones.phase"),
-                             ("scan_ranges", "scans.range_m")):
+                             ("scan_ranges", "scans.range_m"),
+                             ("scan_angles", "scans.angle_body_rad"),
+                             ("scan_elevations", "scans.elevation_body_rad")):
             if field in s:
                 s[short] = s[field]
         return s

@@ -5,14 +5,18 @@
 //     of range 1 + k + 0.1 * ray; drones 0..N-1, drone N-1 only from tick 10;
 //   ddswarm/status: every 10th tick, its tick and the live agents 0..N-1;
 //   ddswarm/task: once, at the end, complete in 81.06 s.
+// With --ring64 the swarm state is written as recordings made before scans
+// carried elevations were: that IDL as schema, each scan yaw, range and hit.
 // With --crash-after-chunks K it ends without closing the file once K
 // chunks are complete, as a killed recorder does; it prints the swarm-state
 // samples a reader must then find ("swarm_state=N").
 #include <CLI/CLI.hpp>
+
 #include <cstdlib>
 #include <iostream>
 
 #include "common/mcap/mcap_writer.hpp"
+#include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
 #include "ddswarm_idl_text.hpp"
 
@@ -28,10 +32,17 @@ std::vector<std::uint8_t> to_cdr(const T& sample) {
     throw std::runtime_error("cannot serialize");
   return std::vector<std::uint8_t>(payload.data, payload.data + payload.length);
 }
+/// That IDL: today's without the elevations.
+std::string ring64_idl() {
+  std::string idl = kIdlText;
+  const auto at = idl.find("  sequence<float, 256> elevation_body_rad;");
+  idl.erase(at, idl.find('\n', at) + 1 - at);
+  return idl;
+}
 template <class T>
-std::uint16_t channel(mcap::Writer& w) {
+std::uint16_t channel(mcap::Writer& w, const std::string& idl = kIdlText) {
   typename Topic<T>::PubSub type;
-  return w.add_channel(w.add_schema(type.getName(), "omgidl", kIdlText), Topic<T>::name, "cdr", {});
+  return w.add_channel(w.add_schema(type.getName(), "omgidl", idl), Topic<T>::name, "cdr", {});
 }
 msg::Vec3 vec(double x, double y, double z) {
   msg::Vec3 v;
@@ -47,16 +58,18 @@ int main(int argc, char** argv) {
   std::string out;
   int ticks = 300, drones = 4;
   unsigned crash_after_chunks = 0;
+  bool ring64 = false;
   app.add_option("output", out)->required();
   app.add_option("--ticks", ticks);
   app.add_option("--drones", drones);
   app.add_option("--crash-after-chunks", crash_after_chunks);
+  app.add_flag("--ring64", ring64);
   CLI11_PARSE(app, argc, argv);
   mcap::WriterOptions opt;
   opt.chunk_size_bytes = 16 * 1024;
   mcap::Writer w(out, opt);
-  const auto c_state = channel<msg::SwarmState>(w), c_status = channel<msg::SimStatus>(w),
-             c_task = channel<msg::TaskStatus>(w);
+  const auto c_state = channel<msg::SwarmState>(w, ring64 ? ring64_idl() : kIdlText),
+             c_status = channel<msg::SimStatus>(w), c_task = channel<msg::TaskStatus>(w);
   std::uint64_t states = 0, durable = 0, chunks = 0;
   for (int tick = 0; tick < ticks; ++tick) {
     const std::uint64_t t_ns = 1'000'000'000ull + static_cast<std::uint64_t>(tick) * 20'000'000ull;
@@ -82,10 +95,11 @@ int main(int argc, char** argv) {
         sc.range_m().push_back(static_cast<float>(1 + k + 0.1 * r));
         sc.hit().push_back(r % 2);
         sc.angle_body_rad().push_back(static_cast<float>(r * 0.785398));
+        sc.elevation_body_rad().push_back(0.0f);
       }
       s.scans().push_back(sc);
     }
-    const auto bytes = to_cdr(s);
+    const auto bytes = ring64 ? encode_swarm_state(s, false, ScanLayout::kRing64) : to_cdr(s);
     w.write(c_state, t_ns, t_ns, bytes.data(), bytes.size());
     ++states;
     if (w.chunks_written() != chunks) {

@@ -47,6 +47,18 @@ def test_swarm_state_as_arrays(tmp_path):
     assert s["scans.hit"][200, 0].tolist() == [0, 1, 0, 1, 0, 1, 0, 1]
     assert np.all(np.diff(s.log_time_s) > 0)
     assert s.undecodable == 0
+    # The ring: every ray level, at its body yaw.
+    assert s.scan_elevations.shape == (300, 4, 8) and (s.scan_elevations[200] == 0).all()
+    np.testing.assert_allclose(s.scan_angles[200, 0], 0.785398 * np.arange(8), rtol=1e-6)
+
+
+def test_a_recording_from_before_scan_elevations_reads_as_a_level_ring(tmp_path):
+    f = tmp_path / "old.mcap"
+    fixture(f, "--ring64")
+    s = ddswarm.Recording(f).swarm_state()
+    assert s.undecodable == 0 and len(s) == 300
+    np.testing.assert_allclose(s.scan_ranges[200, 1], 2 + 0.1 * np.arange(8), rtol=1e-6)
+    assert (s.scan_elevations[200] == 0).all()
 
 
 def test_other_topics(tmp_path):

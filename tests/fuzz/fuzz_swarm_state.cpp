@@ -45,8 +45,9 @@ msg::SwarmState build(FuzzedDataProvider& f) {
     msg::DistanceScan sc;
     sc.drone_id(static_cast<std::uint16_t>(i));
     sc.max_range_m(f.ConsumeFloatingPoint<float>());
-    for (int k = 0, rays = f.ConsumeIntegralInRange(0, 64); k < rays; ++k) {
+    for (int k = 0, rays = f.ConsumeIntegralInRange(0, 256); k < rays; ++k) {
       sc.angle_body_rad().push_back(f.ConsumeFloatingPoint<float>());
+      sc.elevation_body_rad().push_back(f.ConsumeFloatingPoint<float>());
       sc.range_m().push_back(f.ConsumeFloatingPoint<float>());
       sc.hit().push_back(f.ConsumeIntegral<std::uint8_t>());
     }
@@ -92,8 +93,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(fast.drones().size() <= 1024 && fast.scans().size() <= 1024 &&
              fast.beacons().size() <= 1024 && fast.recent_commands().size() <= 8);
   for (const auto& sc : fast.scans())
-    FUZZ_CHECK(sc.angle_body_rad().size() <= 64 && sc.range_m().size() <= 64 &&
-               sc.hit().size() <= 64);
+    FUZZ_CHECK(sc.angle_body_rad().size() <= 256 && sc.elevation_body_rad().size() <= 256 &&
+               sc.range_m().size() <= 256 && sc.hit().size() <= 256);
   // The generated code reads the same bytes to the same sample.
   msg::SwarmStatePubSubType generated;
   eprosima::fastrtps::rtps::SerializedPayload_t p(static_cast<std::uint32_t>(bytes.size()));

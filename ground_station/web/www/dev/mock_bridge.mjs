@@ -256,7 +256,7 @@ class MockSwarm {
   }
 
   rays(a) {
-    const m = this.scene.sensor_count, R = this.scene.sensor_range, out = { a: [], r: [], hit: [] };
+    const m = this.scene.sensor_count, R = this.scene.sensor_range, out = { a: [], e: [], r: [], hit: [] };
     for (let k = 0; k < m; k++) {
       const ang = (2 * Math.PI * k) / m, wa = ang + a.yaw, dx = Math.cos(wa), dy = Math.sin(wa);
       let best = R;
@@ -267,7 +267,7 @@ class MockSwarm {
         const s = -b - Math.sqrt(disc);
         if (s > 0 && s < best) best = s;
       }
-      out.a.push(r3(ang)); out.r.push(r3(best)); out.hit.push(best < R ? 1 : 0);
+      out.a.push(r3(ang)); out.e.push(0); out.r.push(r3(best)); out.hit.push(best < R ? 1 : 0);
     }
     return out;
   }

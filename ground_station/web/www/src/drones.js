@@ -155,7 +155,7 @@ export class Drones {
     this.groundZ = groundZ;
     this.n = n;
     this.arm = arm > 0 ? arm : 0.2275;
-    this.sensorCount = Math.max(0, Math.min(64, sensorCount | 0));
+    this.sensorCount = Math.max(0, Math.min(256, sensorCount | 0)); // rays per scan (rows x columns)
     const g = quadGeometry(this.arm);
     const mk = (geo, mat, count, shadow = true) => {
       const m = new THREE.InstancedMesh(geo, mat, count);
@@ -346,10 +346,13 @@ export class Drones {
       if (!this.present[i] || !r || !Array.isArray(r.a) || !Array.isArray(r.r)) continue;
       q.set(this.quat[4 * i], this.quat[4 * i + 1], this.quat[4 * i + 2], this.quat[4 * i + 3]);
       const x = this.pos[3 * i], y = this.pos[3 * i + 1], z = this.pos[3 * i + 2];
+      const e = Array.isArray(r.e) ? r.e : [];
       for (let k = 0; k < Math.min(m, r.a.length); k++) {
         const len = r.r[k];
         if (!Number.isFinite(len)) continue;
-        v.set(Math.cos(r.a[k]), Math.sin(r.a[k]), 0).applyQuaternion(q).multiplyScalar(len);
+        // Body yaw and elevation (up from the body x-y plane; 0: the ring), turned with the body.
+        const el = Number.isFinite(e[k]) ? e[k] : 0, ce = Math.cos(el);
+        v.set(ce * Math.cos(r.a[k]), ce * Math.sin(r.a[k]), Math.sin(el)).applyQuaternion(q).multiplyScalar(len);
         P.set([x, y, z, x + v.x, y + v.y, z + v.z], 6 * seg);
         const hit = r.hit?.[k];
         if (hit) C.set([1, 0.45, 0.1, 1, 0.25, 0.05], 6 * seg);
