@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "common/mcap/mcap_reader.hpp"
+#include "common/recorded_sample.hpp"
 #include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
 #include "message_visit.hpp"
@@ -217,27 +218,6 @@ class Columns {
   std::vector<Column> columns_;
 };
 
-/// Deserialises one recorded CDR payload (encapsulation header included);
-/// scans as the recording's schema lays them out (scan_layout_of).
-template <class T>
-bool from_cdr(std::span<const std::uint8_t> bytes, T& sample, ScanLayout layout) {
-  if constexpr (std::is_same_v<T, msg::SwarmState>) {
-    return decode_swarm_state(bytes.data(), bytes.size(), sample, layout);
-  } else if constexpr (std::is_same_v<T, msg::DistanceScan>) {
-    return decode_distance_scan(bytes.data(), bytes.size(), sample, layout);
-  } else {
-    typename Topic<T>::PubSub type;
-    eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
-    std::memcpy(payload.data, bytes.data(), bytes.size());
-    payload.length = static_cast<std::uint32_t>(bytes.size());
-    try {
-      return type.deserialize(&payload, &sample);
-    } catch (const std::exception&) {  // fastcdr throws on truncated data
-      return false;
-    }
-  }
-}
-
 /// Opens path, as Python expects of a missing file or one that is not MCAP.
 std::unique_ptr<mcap::Reader> open(const std::string& path) {
   std::error_code ec;
@@ -282,8 +262,7 @@ py::dict read_topic(const std::string& path, const std::string& topic) {
   for (const auto& [id, ch] : r->channels())
     if (ch.topic == topic) {
       ids.push_back(id);
-      const auto schema = r->schemas().find(ch.schema_id);
-      layout[id] = scan_layout_of(schema == r->schemas().end() ? "" : schema->second.data);
+      layout[id] = channel_scan_layout(*r, ch);
     }
   if (ids.empty()) throw py::key_error(path + ": no topic '" + topic + "' in this recording");
   py::dict out;

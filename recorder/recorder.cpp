@@ -17,14 +17,13 @@
 #include <span>
 #include <string>
 #include <thread>
-#include <type_traits>
 #include <vector>
 
 #include "common/mcap/mcap_reader.hpp"
 #include "common/mcap/mcap_writer.hpp"
 #include "common/participant.hpp"
 #include "common/process.hpp"
-#include "common/swarm_state_cdr.hpp"
+#include "common/recorded_sample.hpp"
 #include "ddswarm_idl_text.hpp"
 #include "recorder/sequence_gaps.hpp"
 
@@ -330,24 +329,10 @@ std::uint64_t Replay::run() {
           if (!dds.profile_never_shares<T>()) shared.insert(id);
           // A recording made before scans carried elevations is replayed as
           // this build writes scans (every elevation 0).
-          const auto schema = r.schemas().find(ch.schema_id);
-          const ScanLayout layout =
-              scan_layout_of(schema == r.schemas().end() ? "" : schema->second.data);
+          const ScanLayout layout = channel_scan_layout(r, ch);
           publish[id] = [w, layout](std::span<const std::uint8_t> bytes) {
             T sample;
-            if constexpr (std::is_same_v<T, msg::SwarmState>) {
-              if (decode_swarm_state(bytes.data(), bytes.size(), sample, layout)) w->write(sample);
-            } else if constexpr (std::is_same_v<T, msg::DistanceScan>) {
-              if (decode_distance_scan(bytes.data(), bytes.size(), sample, layout))
-                w->write(sample);
-            } else {
-              typename Topic<T>::PubSub type;
-              eprosima::fastrtps::rtps::SerializedPayload_t payload(
-                  static_cast<std::uint32_t>(bytes.size()));
-              std::memcpy(payload.data, bytes.data(), bytes.size());
-              payload.length = static_cast<std::uint32_t>(bytes.size());
-              if (type.deserialize(&payload, &sample)) w->write(sample);
-            }
+            if (from_cdr(bytes, sample, layout)) w->write(sample);
           };
         });
   }

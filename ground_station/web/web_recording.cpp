@@ -6,26 +6,12 @@
 #include <stdexcept>
 
 #include "common/mcap/mcap_reader.hpp"
-#include "common/swarm_state_cdr.hpp"
+#include "common/recorded_sample.hpp"
 #include "common/topics.hpp"
 
 namespace ddswarm::gs::web {
 
 namespace {
-
-/// Deserialises one CDR payload (encapsulation header included, as recorded).
-template <class T>
-bool from_cdr(std::span<const std::uint8_t> bytes, T& sample) {
-  typename Topic<T>::PubSub type;
-  eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
-  std::memcpy(payload.data, bytes.data(), bytes.size());
-  payload.length = static_cast<std::uint32_t>(bytes.size());
-  try {
-    return type.deserialize(&payload, &sample);
-  } catch (const std::exception&) {  // fastcdr throws on truncated data
-    return false;
-  }
-}
 
 std::uint64_t frame_bytes(const Frame& f) {
   std::uint64_t b = sizeof(Frame) + f.drones.size() * sizeof(DroneFrame);
@@ -49,8 +35,7 @@ std::shared_ptr<Recording> load_recording(const std::string& path, const std::st
   std::map<std::uint16_t, Kind> kind;
   std::map<std::uint16_t, ScanLayout> layout;  // a recording made before scans had elevations
   for (const auto& [id, ch] : reader.channels()) {
-    const auto schema = reader.schemas().find(ch.schema_id);
-    layout[id] = scan_layout_of(schema == reader.schemas().end() ? "" : schema->second.data);
+    layout[id] = channel_scan_layout(reader, ch);
     Kind k = Kind::kNone;
     if (ch.topic == Topic<msg::SwarmState>::name) k = Kind::kState;
     if (ch.topic == Topic<msg::Scene>::name) k = Kind::kScene;
@@ -79,7 +64,7 @@ std::shared_ptr<Recording> load_recording(const std::string& path, const std::st
       case Kind::kNone:
         return;
       case Kind::kState: {
-        if (!decode_swarm_state(m.data.data(), m.data.size(), state, layout[m.channel_id])) {
+        if (!from_cdr(m.data, state, layout[m.channel_id])) {
           ++undecodable;
           return;
         }
