@@ -194,77 +194,85 @@ TEST(PhysicsWorld, GroundEffectLiftsAHoverNearTheGroundAsCheesemanAndBennettSay)
   EXPECT_NEAR((w.state(0).v_world.z() - v0) / 0.01, kGravityMps2 / 15, 0.1 * kGravityMps2 / 15);
 }
 
-TEST(PhysicsWorld, DownwashPushesADroneHalfAMetreBelowAnotherAsTheModelSays) {
-  QuadrotorParams q;
-  PhysicsWorld w(empty_scene(), q, {{0, 0, 0}, {3, 0, 0}}, 0.0);
+/// The downward push on the lower drone of each (top, low) pair, measured
+/// against the top one (N, from their vertical accelerations over 5 ms), and
+/// the model's force. Every drone of w was just reset: the rotors spin up to
+/// hover for 20 ms first, all alike, so only the downwash tells them apart.
+struct Push {
+  double measured_n, model_n;
+};
+std::vector<Push> downwash_pushes(PhysicsWorld& w, const AeroConfig& a,
+                                  const std::vector<std::pair<int, int>>& pairs) {
+  const QuadrotorParams& q = w.params();
+  const double h = q.hover_omega();
+  const int n = static_cast<int>(pairs.size()) * 2;
+  for (int i = 0; i < n; ++i) w.set_rotor_commands(i, {h, h, h, h});
+  step_for(w, 0.02);
+  std::vector<double> v0;
+  for (int i = 0; i < n; ++i) v0.push_back(w.state(i).v_world.z());
+  step_for(w, 0.005);
+  std::vector<Push> out;
+  for (const auto& [top, low] : pairs) {
+    const double a_top = (w.state(top).v_world.z() - v0[top]) / 0.005;
+    const double a_low = (w.state(low).v_world.z() - v0[low]) / 0.005;
+    out.push_back(
+        {(a_top - a_low) * q.mass_kg,
+         downwash_force(a, w.state(top).p_world, w.state(low).p_world, 0.5 * q.prop_diameter_m)});
+  }
+  return out;
+}
+
+AeroConfig downwash_only() {
   AeroConfig a;
   a.downwash = true;
+  return a;
+}
+
+TEST(PhysicsWorld, DownwashPushesADroneHalfAMetreBelowAnotherAsTheModelSays) {
+  PhysicsWorld w(empty_scene(), QuadrotorParams{}, {{0, 0, 0}, {3, 0, 0}}, 0.0);
+  const AeroConfig a = downwash_only();
   w.set_aero(a);
   w.reset_drone(0, {0, 0, 20.5}, 0.0);
   w.reset_drone(1, {0, 0, 20.0}, 0.0);
-  const double h = q.hover_omega();
-  for (int i : {0, 1}) w.set_rotor_commands(i, {h, h, h, h});
-  step_for(w, 0.02);
-  const double v_top = w.state(0).v_world.z(), v_low = w.state(1).v_world.z();
-  step_for(w, 0.005);
-  const double force =
-      downwash_force(a, w.state(0).p_world, w.state(1).p_world, 0.5 * q.prop_diameter_m);
-  EXPECT_GT(force, 1.0);
-  // Against the drone above, which feels nothing (both still spin up alike).
-  const double a_top = (w.state(0).v_world.z() - v_top) / 0.005;
-  const double a_low = (w.state(1).v_world.z() - v_low) / 0.005;
-  EXPECT_NEAR((a_low - a_top) * q.mass_kg, -force, 0.05 * force);
+  const Push p = downwash_pushes(w, a, {{0, 1}})[0];
+  EXPECT_GT(p.model_n, 1.0);
+  // Against the drone above, which feels nothing.
+  EXPECT_NEAR(p.measured_n, p.model_n, 0.05 * p.model_n);
 }
 
 TEST(PhysicsWorld, DownwashReachesADroneAcrossTheNeighbourGridsCellLines) {
-  // The server finds who is above whom on a 10 m grid; a pair 2 cm apart
-  // sideways across a cell line (at x = 10, at y = -10, at the origin's
-  // corner) is pushed as one within a cell is.
-  QuadrotorParams q;
-  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> pairs = {
-      {{5, 5, 20.5}, {5.02, 5, 20}},          // one cell
-      {{9.99, 100, 20.5}, {10.01, 100, 20}},  // across x = 10
-      {{100, -9.99, 20.5}, {100, -10.01, 20}},
-      {{-100.01, -0.01, 20.5}, {-99.99, 0.01, 20}}};  // across x = -100 and y = 0
+  // The server finds who is above whom on a grid of 12 m cells; a pair 2 cm
+  // apart sideways across a cell line (at x = 12, at y = -12, at the
+  // origin's corner) is pushed as one within a cell is.
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> places = {
+      {{5, 5, 20.5}, {5.02, 5, 20}},           // one cell
+      {{11.99, 100, 20.5}, {12.01, 100, 20}},  // across x = 12
+      {{100, -11.99, 20.5}, {100, -12.01, 20}},
+      {{-108.01, -0.01, 20.5}, {-107.99, 0.01, 20}}};  // across x = -108 and y = 0
   std::vector<Eigen::Vector3d> starts;
-  for (const auto& [top, low] : pairs) starts.insert(starts.end(), {top, low});
-  PhysicsWorld w(empty_scene(), q, starts, 0.0);
-  AeroConfig a;
-  a.downwash = true;
+  std::vector<std::pair<int, int>> pairs;
+  for (const auto& [top, low] : places) {
+    pairs.push_back({static_cast<int>(starts.size()), static_cast<int>(starts.size()) + 1});
+    starts.insert(starts.end(), {top, low});
+  }
+  PhysicsWorld w(empty_scene(), QuadrotorParams{}, starts, 0.0);
+  const AeroConfig a = downwash_only();
   w.set_aero(a);
-  const double h = q.hover_omega();
-  for (std::size_t i = 0; i < starts.size(); ++i) {
-    w.reset_drone(static_cast<int>(i), starts[i], 0.0);
-    w.set_rotor_commands(static_cast<int>(i), {h, h, h, h});
-  }
-  step_for(w, 0.02);
-  std::vector<double> v0;
   for (std::size_t i = 0; i < starts.size(); ++i)
-    v0.push_back(w.state(static_cast<int>(i)).v_world.z());
-  step_for(w, 0.005);
-  std::vector<double> pushed;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const int top = static_cast<int>(2 * k), low = top + 1;
-    const double force =
-        downwash_force(a, w.state(top).p_world, w.state(low).p_world, 0.5 * q.prop_diameter_m);
-    const double a_top = (w.state(top).v_world.z() - v0[top]) / 0.005;
-    const double a_low = (w.state(low).v_world.z() - v0[low]) / 0.005;
-    pushed.push_back((a_top - a_low) * q.mass_kg);
-    EXPECT_NEAR(pushed.back(), force, 0.05 * force) << "pair " << k;
-  }
-  EXPECT_GT(pushed[0], 1.0);
+    w.reset_drone(static_cast<int>(i), starts[i], 0.0);
+  const std::vector<Push> pushed = downwash_pushes(w, a, pairs);
+  for (std::size_t k = 0; k < pushed.size(); ++k)
+    EXPECT_NEAR(pushed[k].measured_n, pushed[k].model_n, 0.05 * pushed[k].model_n) << "pair " << k;
+  EXPECT_GT(pushed[0].measured_n, 1.0);
 }
 
 TEST(PhysicsWorld, DownwashFindsADroneThatCameUnderAnotherAFewCentimetresAStep) {
   // Who may push whom is found again only once a drone has moved a metre; a
   // drone that comes 13 m sideways under another, 0.6 m between steps, is
   // pushed as the model says once below it.
-  QuadrotorParams q;
-  PhysicsWorld w(empty_scene(), q, {{0, 0, 0}, {13, 0, 0}}, 0.0);
-  AeroConfig a;
-  a.downwash = true;
+  PhysicsWorld w(empty_scene(), QuadrotorParams{}, {{0, 0, 0}, {13, 0, 0}}, 0.0);
+  const AeroConfig a = downwash_only();
   w.set_aero(a);
-  const double h = q.hover_omega();
   for (double x = 13.0; x > 0.0; x -= 0.6) {
     w.reset_drone(0, {0, 0, 20.5}, 0.0);
     w.reset_drone(1, {x, 0, 20.0}, 0.0);
@@ -272,16 +280,9 @@ TEST(PhysicsWorld, DownwashFindsADroneThatCameUnderAnotherAFewCentimetresAStep) 
   }
   w.reset_drone(0, {0, 0, 20.5}, 0.0);
   w.reset_drone(1, {0.02, 0, 20.0}, 0.0);
-  for (int i : {0, 1}) w.set_rotor_commands(i, {h, h, h, h});
-  step_for(w, 0.02);
-  const double v_top = w.state(0).v_world.z(), v_low = w.state(1).v_world.z();
-  step_for(w, 0.005);
-  const double force =
-      downwash_force(a, w.state(0).p_world, w.state(1).p_world, 0.5 * q.prop_diameter_m);
-  EXPECT_GT(force, 1.0);
-  const double a_top = (w.state(0).v_world.z() - v_top) / 0.005;
-  const double a_low = (w.state(1).v_world.z() - v_low) / 0.005;
-  EXPECT_NEAR((a_top - a_low) * q.mass_kg, force, 0.05 * force);
+  const Push p = downwash_pushes(w, a, {{0, 1}})[0];
+  EXPECT_GT(p.model_n, 1.0);
+  EXPECT_NEAR(p.measured_n, p.model_n, 0.05 * p.model_n);
 }
 
 TEST(PhysicsWorld, RotorTorquesTurnTheBodyTheWayTheModelSays) {
