@@ -16,20 +16,28 @@ own=$(ls -l /proc/"$sim"/fd | grep -o "fastrtps_port[0-9]*_el" | sed 's/_el$//' 
 for p in $own; do rm -f "/dev/shm/$p"; done
 agent=$(pgrep -f -- "ddswarm-agent --id 2 .*--domain $DOMAIN\b") || fail "no agent 2 process"
 kill -USR1 "$agent"  # join again as a new participant
+# Drone 2 is flown again once the server has heard the participant the agent
+# made last (after it left the shared-memory transport), not merely while its
+# row still shows the old participant's flight.
 ok=0
-for _ in $(seq 60); do
-  status=$(gs status --drones 2>/dev/null)
-  if echo "$status" | awk '$1 == "2" && /airborne/ && !/failsafe/ && !/no-agent/ { found = 1 } END { exit !found }'; then
-    ok=1
-    break
+for _ in $(seq 120); do
+  if grep -q "joining again without the shared-memory transport" "$WORK/agent_2.log"; then
+    last=$(grep -o "agent [0-9a-f]\{16\} flying" "$WORK/agent_2.log" | tail -1 | awk '{print $2}')
+    if grep -q "drone 2: agent $last online" "$WORK/sim.log"; then
+      status=$(gs status --drones 2>/dev/null)
+      if echo "$status" | awk '$1 == "2" && /airborne/ && !/failsafe/ && !/no-agent/ { found = 1 } END { exit !found }'; then
+        ok=1
+        break
+      fi
+    fi
   fi
   sleep 0.5
 done
-echo "$status"
+echo "${status:-no status read}"
 grep -h "does not hear\|without the shared-memory\|init_port" "$WORK"/agent_2.log || true
-[ $ok -eq 1 ] || { shm_ports "$sim" "$agent"; fail "drone 2 was not flown by its agent again"; }
 grep -q "joining again without the shared-memory transport" "$WORK/agent_2.log" ||
-  fail "agent 2 flies again but never left the shared-memory transport: the test did not take the path it tests"
+  fail "agent 2 never left the shared-memory transport: the test did not take the path it tests"
+[ $ok -eq 1 ] || { shm_ports "$sim" "$agent"; fail "drone 2 was not flown again by the agent's last participant (${last:-none})"; }
 # The newcomer did not take the server's participant id for a free one (its
 # port files were gone): Fast DDS then cannot lock those ports and says so.
 ! grep -q "Failed init_port" "$WORK/agent_2.log" || fail "agent 2's new participant took the server's participant id"

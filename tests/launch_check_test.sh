@@ -39,7 +39,7 @@ launch_logged() { launch "$@" --log-dir "$logs"; }
 # Through the agent's section, the server's (sensors), an unknown key, a malformed --set.
 refused "agent value" "ddswarm-launch: error: --set agent.inter_distance_m=-1: must be > 0" \
   launch "$scenario" --set agent.inter_distance_m=-1 --gs "takeoff --wait"
-refused "sensors value" "ddswarm-launch: error: --set sensors.count=100000: must be in [1, 64]" \
+refused "sensors value" "ddswarm-launch: error: --set sensors.count=100000: must be in [1, 256]" \
   launch "$scenario" --set sensors.count=100000 --gs "takeoff --wait"
 refused "unknown key" "ddswarm-launch: error: --set agent.inter_distanse_m=3: unknown key" \
   launch_logged "$scenario" --set agent.inter_distanse_m=3
@@ -65,7 +65,7 @@ refused "file value with --set" \
 # The same through agent hosts and --only agents.
 refused "agent hosts" "ddswarm-launch: error: --set agent.inter_distance_m=0: must be > 0" \
   launch_logged "$scenario" --set agent.inter_distance_m=0 --agent-hosts 2
-refused "only the server" "ddswarm-launch: error: --set sensors.count=0: must be in [1, 64]" \
+refused "only the server" "ddswarm-launch: error: --set sensors.count=0: must be in [1, 256]" \
   launch_logged "$scenario" --set sensors.count=0 --only server
 
 # --check: one line and 0, or the error and 2; it starts nothing either.
@@ -98,7 +98,7 @@ experiment() { timeout 20 "$BIN/ddswarm-gs" --domain "$DOMAIN" experiment "$WORK
 refused "experiment set" \
   "ddswarm-gs: error: $WORK/exp.yaml:9: set 'Tight': agent.inter_distance_m = 0: must be > 0" \
   experiment --out "$WORK/exp1"
-refused "experiment --set" "ddswarm-gs: error: --set sensors.count=100000: must be in [1, 64]" \
+refused "experiment --set" "ddswarm-gs: error: --set sensors.count=100000: must be in [1, 256]" \
   experiment --out "$WORK/exp2" --set sensors.count=100000
 [ ! -e "$WORK/exp1/bad.csv" ] && [ ! -e "$WORK/exp1/logs" ] || problems+=("the bad experiment ran a run")
 # A bad value of the experiment's scenario file itself names that file and its line, and the
