@@ -24,6 +24,18 @@ std::string mission_problem(const msg::MissionCommand& m) {
   return {};
 }
 
+std::string scan_problem(const msg::DistanceScan& s) {
+  const std::size_t n = s.range_m().size();
+  if (s.angle_body_rad().size() != n || s.elevation_body_rad().size() != n || s.hit().size() != n)
+    return "its sequences differ in length (yaw " + std::to_string(s.angle_body_rad().size()) +
+           ", elevation " + std::to_string(s.elevation_body_rad().size()) + ", range " +
+           std::to_string(n) + ", hit " + std::to_string(s.hit().size()) + ")";
+  for (std::size_t k = 0; k < n; ++k)
+    if (!std::isfinite(s.angle_body_rad()[k]) || !std::isfinite(s.elevation_body_rad()[k]))
+      return "ray " + std::to_string(k) + "'s direction is not finite";
+  return {};
+}
+
 MissionCommand from_msg(const msg::MissionCommand& m) {
   MissionCommand c;
   c.seq = m.seq();

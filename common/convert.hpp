@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "DistanceScan.h"
 #include "Geometry.h"
 #include "MissionAck.h"
 #include "MissionCommand.h"
@@ -34,6 +35,10 @@ inline msg::Quat to_msg(const Eigen::Quaterniond& q) {
 /// Why a mission command is unacceptable, or empty if it is fine: unknown
 /// type, non-finite or absurd values. Shared by server and agents.
 std::string mission_problem(const msg::MissionCommand& m);
+
+/// Why a scan is unfit to fly from: its four sequences differ in length, or a
+/// ray's yaw or elevation is not finite; empty when it is sound.
+std::string scan_problem(const msg::DistanceScan& s);
 
 MissionCommand from_msg(const msg::MissionCommand& m);
 msg::MissionCommand to_msg(const MissionCommand& c);

@@ -138,3 +138,21 @@ TEST(Convert, VectorsAndAttitudesRoundTripExactly) {
   const Eigen::Quaterniond q(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   EXPECT_EQ(from_msg(to_msg(q)).coeffs(), q.coeffs());
 }
+
+TEST(Convert, AMalformedScanIsNamed) {
+  msg::DistanceScan sc;
+  for (int k = 0; k < 4; ++k) {
+    sc.angle_body_rad().push_back(0);
+    sc.elevation_body_rad().push_back(0);
+    sc.range_m().push_back(1);
+    sc.hit().push_back(1);
+  }
+  EXPECT_EQ(scan_problem(sc), "");
+  msg::DistanceScan short_elevation = sc;
+  short_elevation.elevation_body_rad().pop_back();
+  EXPECT_EQ(scan_problem(short_elevation),
+            "its sequences differ in length (yaw 4, elevation 3, range 4, hit 4)");
+  msg::DistanceScan nan_elevation = sc;
+  nan_elevation.elevation_body_rad()[2] = NAN;
+  EXPECT_EQ(scan_problem(nan_elevation), "ray 2's direction is not finite");
+}

@@ -223,18 +223,6 @@ ScanLayout scan_layout_of(std::string_view schema_idl) {
                                                                     : ScanLayout::kCurrent;
 }
 
-std::string scan_problem(const msg::DistanceScan& s) {
-  const std::size_t n = s.range_m().size();
-  if (s.angle_body_rad().size() != n || s.elevation_body_rad().size() != n || s.hit().size() != n)
-    return "its sequences differ in length (yaw " + std::to_string(s.angle_body_rad().size()) +
-           ", elevation " + std::to_string(s.elevation_body_rad().size()) + ", range " +
-           std::to_string(n) + ", hit " + std::to_string(s.hit().size()) + ")";
-  for (std::size_t k = 0; k < n; ++k)
-    if (!std::isfinite(s.angle_body_rad()[k]) || !std::isfinite(s.elevation_body_rad()[k]))
-      return "ray " + std::to_string(k) + "'s direction is not finite";
-  return {};
-}
-
 std::vector<std::uint8_t> encode_swarm_state(const msg::SwarmState& s, bool big_endian,
                                              ScanLayout layout) {
   msg::SwarmStatePubSubType type;

@@ -41,10 +41,6 @@ bool decode_distance_scan(const std::uint8_t* data, std::size_t size, msg::Dista
 /// declares no elevation_body_rad is kRing64; anything else, or no text, kCurrent.
 ScanLayout scan_layout_of(std::string_view schema_idl);
 
-/// Why a scan is unfit to fly from: its four sequences differ in length, or a
-/// ray's yaw or elevation is not finite; empty when it is sound.
-std::string scan_problem(const msg::DistanceScan& s);
-
 /// The bytes the generated code puts on the wire for `s`, encapsulation
 /// first, in the byte order asked (Fast DDS writes the machine's): what the
 /// decoder is checked against in its test, fuzz target and bench. With

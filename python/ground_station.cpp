@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "common/config_error.hpp"
+#include "common/convert.hpp"
 #include "common/mission.hpp"
 #include "common/process.hpp"
 #include "common/swarm_state_cdr.hpp"
