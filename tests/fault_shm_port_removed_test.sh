@@ -19,24 +19,19 @@ kill -USR1 "$agent"  # join again as a new participant
 # Drone 2 is flown again once the server has heard the participant the agent
 # made last (after it left the shared-memory transport), not merely while its
 # row still shows the old participant's flight.
+left_shm() { grep -q "joining again without the shared-memory transport" "$WORK/agent_2.log"; }
+flown_again() {
+  left_shm || return 1
+  last=$(grep -o "agent [0-9a-f]\{16\} flying" "$WORK/agent_2.log" | tail -1 | awk '{print $2}')
+  grep -q "drone 2: agent $last online" "$WORK/sim.log" || return 1
+  status=$(gs status --drones 2>/dev/null)
+  echo "$status" | awk '$1 == "2" && /airborne/ && !/failsafe/ && !/no-agent/ { found = 1 } END { exit !found }'
+}
 ok=0
-for _ in $(seq 120); do
-  if grep -q "joining again without the shared-memory transport" "$WORK/agent_2.log"; then
-    last=$(grep -o "agent [0-9a-f]\{16\} flying" "$WORK/agent_2.log" | tail -1 | awk '{print $2}')
-    if grep -q "drone 2: agent $last online" "$WORK/sim.log"; then
-      status=$(gs status --drones 2>/dev/null)
-      if echo "$status" | awk '$1 == "2" && /airborne/ && !/failsafe/ && !/no-agent/ { found = 1 } END { exit !found }'; then
-        ok=1
-        break
-      fi
-    fi
-  fi
-  sleep 0.5
-done
+for _ in $(seq 120); do flown_again && { ok=1; break; }; sleep 0.5; done
 echo "${status:-no status read}"
 grep -h "does not hear\|without the shared-memory\|init_port" "$WORK"/agent_2.log || true
-grep -q "joining again without the shared-memory transport" "$WORK/agent_2.log" ||
-  fail "agent 2 never left the shared-memory transport: the test did not take the path it tests"
+left_shm || fail "agent 2 never left the shared-memory transport: the test did not take the path it tests"
 [ $ok -eq 1 ] || { shm_ports "$sim" "$agent"; fail "drone 2 was not flown again by the agent's last participant (${last:-none})"; }
 # The newcomer did not take the server's participant id for a free one (its
 # port files were gone): Fast DDS then cannot lock those ports and says so.
