@@ -19,10 +19,10 @@ void ExperimentConfig::validate() const {
   if (name.empty()) throw FieldError("experiment.name", "\"\"", "must not be empty");
   if (scenario.empty())
     throw FieldError("experiment.scenario", "\"\"", "must name a scenario file");
-  check_range("experiment.runs_per_set", runs_per_set, 1, 1000);
+  FieldChecker check("experiment");
+  fields(*this, check);
   if (mode != "lockstep" && mode != "realtime")
     throw FieldError("experiment.mode", mode, "must be lockstep or realtime");
-  check_positive("experiment.timeout_s", timeout_s);
   if (sets.empty()) throw FieldError("experiment.sets", "[]", "must list at least one set");
   std::set<std::string> names;
   for (std::size_t i = 0; i < sets.size(); ++i) {
@@ -49,12 +49,8 @@ std::uint64_t ExperimentConfig::seed(int set_index, int run_index) const {
 }
 
 void load(YamlSection s, ExperimentConfig& c, const std::string& base_dir) {
-  s.get("name", c.name);
-  s.get("scenario", c.scenario);
-  s.get("runs_per_set", c.runs_per_set);
-  s.get("base_seed", c.base_seed);
-  s.get("mode", c.mode);
-  s.get("timeout_s", c.timeout_s);
+  FieldLoader fields(s);
+  ExperimentConfig::fields(c, fields);
   c.sets.clear();
   for (YamlSection set : s.children("sets")) {
     ExperimentSet e;

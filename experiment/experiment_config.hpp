@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "common/config_fields.hpp"
 #include "common/scenario_check.hpp"
 #include "common/scenario_overrides.hpp"  // apply_overrides, parse_set_options
 #include "common/yaml_section.hpp"
@@ -43,15 +44,26 @@ struct ExperimentSet {
 };
 
 struct ExperimentConfig {
-  std::string file;                 ///< the experiment file, as named (errors name it)
-  std::string name = "experiment";  ///< used in output file names, non-empty
-  std::string scenario;             ///< scenario file as written
-  std::string scenario_path;        ///< scenario file resolved against the experiment's folder
-  int runs_per_set = 15;            ///< runs of each set, in [1, 1000]
-  std::uint64_t base_seed = 1000;   ///< seed of run 0 of set 0 (see seed())
-  std::string mode = "lockstep";    ///< simulation clock: lockstep | realtime
-  double timeout_s = 300;           ///< s of sim time before a run counts as failed, > 0
-  std::vector<ExperimentSet> sets;  ///< at least one
+  std::string file;  ///< the experiment file, as named (errors name it)
+  std::string name = "experiment";
+  std::string scenario;       ///< scenario file as written
+  std::string scenario_path;  ///< scenario file resolved against the experiment's folder
+  int runs_per_set = 15;
+  std::uint64_t base_seed = 1000;  ///< see seed()
+  std::string mode = "lockstep";
+  double timeout_s = 300;
+  std::vector<ExperimentSet> sets;  ///< at least one; load() reads them (their `set:` is free-form)
+
+  /// The scalar fields of `experiment:`; validate() adds what relates them.
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.field("name", c.name, {"", any(), "output file names; non-empty"});
+    v.field("scenario", c.scenario, {"", any(), "scenario file, relative to the experiment's"});
+    v.field("runs_per_set", c.runs_per_set, {"", in(1, 1000), "runs of each set"});
+    v.field("base_seed", c.base_seed, {"", any(), "seed of run 0 of set 0"});
+    v.field("mode", c.mode, {"", any(), "clock of every run: lockstep or realtime"});
+    v.field("timeout_s", c.timeout_s, {"s (sim)", positive(), "a run's task fails after this"});
+  }
 
   /// Throws FieldError("experiment.…") naming the first bad field.
   void validate() const;

@@ -1,5 +1,7 @@
 #include "experiment/experiment_config.hpp"
 
+#include "common/config_reference.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -135,6 +137,12 @@ TEST(ExperimentConfig, BadValuesNameFieldAndLine) {
   no_sets.resize(no_sets.find("  sets:"));
   EXPECT_EQ(error_of(no_sets),
             "/exp/table.yaml:1: experiment.sets = []: must list at least one set");
+}
+
+TEST(ExperimentConfig, TheReferenceDescribesEveryField) {
+  EXPECT_EQ(reference_mismatches(configuration_reference(), "## Experiment files",
+                                 field_rows<ExperimentConfig>()),
+            std::vector<std::string>{});
 }
 
 TEST(ExperimentConfig, MissingFileIsAConfigError) {

@@ -1,45 +1,80 @@
 #pragma once
 // The `sim:` section: clocks, time mode behaviour, failsafes, limits.
+#include "common/config_fields.hpp"
+#include "common/scene.hpp"
 #include "common/swarm_metrics.hpp"
 #include "common/yaml_section.hpp"
 
 namespace ddswarm::sim {
 
 struct SimConfig {
-  double physics_rate_hz = 1000;  ///< Hz, fixed physics step rate; a multiple of control_rate_hz
-  double control_rate_hz = 50;    ///< Hz, state publish / command rate (one tick)
-  double sensor_rate_hz = 50;     ///< Hz, distance-sensor rate; divides control_rate_hz
-  double command_timeout_s =
-      0.5;  ///< s sim time: a drone without a fresh command hovers (failsafe)
-  double failsafe_land_after_s = 5.0;  ///< s in failsafe before the drone lands by itself
-  double agent_timeout_s = 1.0;        ///< s wall time: an agent silent this long is lost
-  double max_command_speed_mps =
-      50.0;                     ///< m/s: commands above are absurd and rejected (within: clamped)
-  bool pause_when_idle = true;  ///< lockstep: hold the clock while every agent is idle
-  bool lockstep_pipeline =
-      false;  ///< lockstep: step physics while agents answer; commands act one tick later
-  double realtime_grace =
-      0.25;  ///< realtime: wait up to this fraction of a period past its end for late answers
-  bool realtime_pipeline =
-      false;  ///< realtime: publish on the period's edge, step after; commands act one tick later
-  double lockstep_resend_s = 0.25;       ///< s wall, lockstep: publish again if answers are late
-  double status_rate_hz = 2.0;           ///< Hz wall, SimStatus publishing
-  bool publish_per_drone_topics = true;  ///< also publish keyed DroneState/DistanceScan
-  double task_timeout_s = 600.0;         ///< s sim time before a running task fails
-  double airborne_height_m = 0.3;        ///< m above ground: counts as airborne
-  /// m, swarm metrics: drones this close or closer are linked in the
-  /// communication graph (components, λ₂); (0, 100000]
+  double physics_rate_hz = 1000;
+  double control_rate_hz = 50;
+  double sensor_rate_hz = 50;
+  double command_timeout_s = 0.5;
+  double failsafe_land_after_s = 5.0;
+  double agent_timeout_s = 1.0;
+  double max_command_speed_mps = 50.0;
+  bool pause_when_idle = true;
+  bool lockstep_pipeline = false;
+  double lockstep_resend_s = 0.25;
+  double realtime_grace = 0.25;
+  bool realtime_pipeline = false;
+  double status_rate_hz = 2.0;
+  bool publish_per_drone_topics = true;
+  double task_timeout_s = 600.0;
+  double airborne_height_m = 0.3;
   double metrics_range_m = 10.0;
-  /// m centre to centre, swarm metrics: closer is a near miss; (0, 1000]
   double near_miss_m = 1.0;
-  /// swarm metrics: λ₂ (O(N³)) only for swarms up to this size; [0, 1024], 0 = never
   int metrics_lambda2_max_drones = 128;
+
+  template <class Self, class V>
+  static void fields(Self& c, V& v) {
+    v.field("physics_rate_hz", c.physics_rate_hz, {"Hz", in(50, 20000), "fixed physics step rate"});
+    v.field("control_rate_hz", c.control_rate_hz,
+            {"Hz", in(kMinControlRateHz, kMaxControlRateHz),
+             "one tick: state published, one command per drone; divides physics_rate_hz"});
+    v.field("sensor_rate_hz", c.sensor_rate_hz,
+            {"Hz", positive(), "distance-scan rate; divides control_rate_hz"});
+    v.field("command_timeout_s", c.command_timeout_s,
+            {"s (sim)", positive(), "a drone without a fresh command hovers (failsafe)"});
+    v.field("failsafe_land_after_s", c.failsafe_land_after_s,
+            {"s (sim)", non_negative(), "in failsafe this long, the drone lands"});
+    v.field("agent_timeout_s", c.agent_timeout_s,
+            {"s (wall)", in(0.1, 60), "an agent silent this long is lost"});
+    v.field("max_command_speed_mps", c.max_command_speed_mps,
+            {"m/s", positive(), "faster commands are rejected; slower ones clamped"});
+    v.field("pause_when_idle", c.pause_when_idle,
+            {"", any(), "lockstep: hold the clock while every agent is idle"});
+    v.field("lockstep_pipeline", c.lockstep_pipeline,
+            {"", any(), "lockstep: step physics while agents answer; commands act a tick later"});
+    v.field("lockstep_resend_s", c.lockstep_resend_s,
+            {"s (wall)", in(0.005, 10), "lockstep: publish again if answers are late"});
+    v.field("realtime_grace", c.realtime_grace,
+            {"periods", in(0, 0.9), "realtime: wait this fraction of a period for late answers"});
+    v.field("realtime_pipeline", c.realtime_pipeline,
+            {"", any(), "realtime: publish on the period's edge, step after"});
+    v.field("status_rate_hz", c.status_rate_hz, {"Hz (wall)", in(0.1, 100), "SimStatus rate"});
+    v.field("publish_per_drone_topics", c.publish_per_drone_topics,
+            {"", any(), "also publish keyed DroneState and DistanceScan, for tools"});
+    v.field("task_timeout_s", c.task_timeout_s,
+            {"s (sim)", positive(), "a running task fails after this much simulated time"});
+    v.field("airborne_height_m", c.airborne_height_m,
+            {"m", positive(), "above the ground: counts as airborne"});
+    v.field("metrics_range_m", c.metrics_range_m,
+            {"m", up_to(100000), "swarm metrics: this close or closer is linked"});
+    v.field("near_miss_m", c.near_miss_m,
+            {"m, centre to centre", up_to(1000), "swarm metrics: closer is a near miss"});
+    v.field(
+        "metrics_lambda2_max_drones", c.metrics_lambda2_max_drones,
+        {"drones", in(0, 1024), "swarm metrics: lambda2 only up to this many drones; 0 = never"});
+  }
 
   int substeps() const { return static_cast<int>(physics_rate_hz / control_rate_hz + 0.5); }
   int sensor_every() const { return static_cast<int>(control_rate_hz / sensor_rate_hz + 0.5); }
   /// The swarm metrics' options (the task referee's).
   SwarmMetricsOptions metrics() const;
-  void validate() const;
+  void validate() const;  ///< the list's bounds, then the rates that must divide
 };
 
 void load(YamlSection s, SimConfig& c);

@@ -4,6 +4,8 @@
 
 #include <fstream>
 
+#include "common/config_reference.hpp"
+
 using namespace ddswarm;
 using namespace ddswarm::sim;
 
@@ -65,6 +67,11 @@ TEST(ServerConfig, BadInputNamesLineFieldAndValue) {
                       "max_range_m: 26\n"),
             "5: sensors.max_range_m = 26: must be <= the world's size (diagonal of "
             "scene.bounds_min..bounds_max, 25 m)");
+}
+
+TEST(ServerConfig, TheReferenceDescribesEverySimField) {
+  EXPECT_EQ(reference_mismatches(configuration_reference(), "### `sim:`", field_rows<SimConfig>()),
+            std::vector<std::string>{});
 }
 
 TEST(ServerConfig, SwarmMetricsFieldsReachTheRefereesOptions) {
