@@ -3,7 +3,7 @@
 // through the Python-law plug-in), at 6 and 64 peers and the thesis's 8 rays.
 // The ratio Python / C++ is printed as a counter (docs/laws.md).
 //
-//   build/release/bin/law_bench            (or build/default/bin/law_bench)
+//   build/release/bin/law_bench            (./scripts/build release)
 #include <benchmark/benchmark.h>
 
 #include <random>
