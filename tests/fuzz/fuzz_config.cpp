@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <string>
 
-#include "agent/agent_app.hpp"
+#include "agent/agent_app_config.hpp"
 #include "common/config_error.hpp"
 #include "ground_station/gs_app.hpp"
 #include "sim_server/sim_server.hpp"
