@@ -30,6 +30,8 @@
 #include <utility>
 #include <vector>
 
+#include "common/config_fields.hpp"
+
 namespace ddswarm {
 
 /// What the metrics depend on besides the drones.
@@ -38,6 +40,19 @@ struct SwarmMetricsOptions {
   double near_miss_m = 1.0;       ///< m, centre to centre: closer is a near miss; > 0
   int lambda2_max_drones = 128;   ///< λ₂ only for swarms up to this size (O(N³)); 0 = never
   double still_speed_mps = 0.05;  ///< m/s: a drone slower has no heading (its pairs count 0)
+
+  /// The `sim:` keys that set these options: SimConfig lists them with its
+  /// own fields, and `ddswarm-gs trace` reads them alone from a scenario.
+  template <class Self, class V>
+  static void sim_fields(Self& o, V& v) {
+    v.field("metrics_range_m", o.range_m,
+            {"m", up_to(100000), "swarm metrics: this close or closer is linked"});
+    v.field("near_miss_m", o.near_miss_m,
+            {"m, centre to centre", up_to(1000), "swarm metrics: closer is a near miss"});
+    v.field(
+        "metrics_lambda2_max_drones", o.lambda2_max_drones,
+        {"drones", in(0, 1024), "swarm metrics: lambda2 only up to this many drones; 0 = never"});
+  }
 };
 
 /// A near pair's approach ends only once the pair is this many near-miss

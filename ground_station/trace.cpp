@@ -171,12 +171,10 @@ SwarmMetricsOptions scenario_metrics_options(const std::string& path) {
   doc.guard([&] {
     // Only these keys: the rest of sim: is the server's to check.
     YamlSection sim = doc.section("sim");
-    sim.get("metrics_range_m", o.range_m);
-    sim.get("near_miss_m", o.near_miss_m);
-    sim.get("metrics_lambda2_max_drones", o.lambda2_max_drones);
-    check_positive("sim.metrics_range_m", o.range_m);
-    check_positive("sim.near_miss_m", o.near_miss_m);
-    check_range("sim.metrics_lambda2_max_drones", o.lambda2_max_drones, 0, 1024);
+    FieldLoader load(sim);
+    SwarmMetricsOptions::sim_fields(o, load);
+    FieldChecker check("sim");
+    SwarmMetricsOptions::sim_fields(o, check);
   });
   return o;
 }

@@ -108,6 +108,14 @@ TEST(TraceMetrics, OptionsComeFromTheScenariosSimSection) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), path + ":2: sim.near_miss_m = -1: must be > 0");
   }
+  // The server's bounds, from the same declaration.
+  std::ofstream(path, std::ios::trunc) << "sim:\n  near_miss_m: 2000\n";
+  try {
+    scenario_metrics_options(path);
+    FAIL() << "a near_miss_m past the server's bound must be refused";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ":2: sim.near_miss_m = 2000: must be <= 1000");
+  }
 }
 
 }  // namespace

@@ -28,12 +28,4 @@ void SimConfig::validate() const {
                      "must divide control_rate_hz (" + to_text(control_rate_hz) + ")");
 }
 
-SwarmMetricsOptions SimConfig::metrics() const {
-  SwarmMetricsOptions o;
-  o.range_m = metrics_range_m;
-  o.near_miss_m = near_miss_m;
-  o.lambda2_max_drones = metrics_lambda2_max_drones;
-  return o;
-}
-
 }  // namespace ddswarm::sim

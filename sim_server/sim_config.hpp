@@ -24,9 +24,7 @@ struct SimConfig {
   bool publish_per_drone_topics = true;
   double task_timeout_s = 600.0;
   double airborne_height_m = 0.3;
-  double metrics_range_m = 10.0;
-  double near_miss_m = 1.0;
-  int metrics_lambda2_max_drones = 128;
+  SwarmMetricsOptions metrics_options;  ///< sim.metrics_range_m, near_miss_m, ...
 
   template <class Self, class V>
   static void fields(Self& c, V& v) {
@@ -61,19 +59,13 @@ struct SimConfig {
             {"s (sim)", positive(), "a running task fails after this much simulated time"});
     v.field("airborne_height_m", c.airborne_height_m,
             {"m", positive(), "above the ground: counts as airborne"});
-    v.field("metrics_range_m", c.metrics_range_m,
-            {"m", up_to(100000), "swarm metrics: this close or closer is linked"});
-    v.field("near_miss_m", c.near_miss_m,
-            {"m, centre to centre", up_to(1000), "swarm metrics: closer is a near miss"});
-    v.field(
-        "metrics_lambda2_max_drones", c.metrics_lambda2_max_drones,
-        {"drones", in(0, 1024), "swarm metrics: lambda2 only up to this many drones; 0 = never"});
+    SwarmMetricsOptions::sim_fields(c.metrics_options, v);
   }
 
   int substeps() const { return static_cast<int>(physics_rate_hz / control_rate_hz + 0.5); }
   int sensor_every() const { return static_cast<int>(control_rate_hz / sensor_rate_hz + 0.5); }
   /// The swarm metrics' options (the task referee's).
-  SwarmMetricsOptions metrics() const;
+  const SwarmMetricsOptions& metrics() const { return metrics_options; }
   void validate() const;  ///< the list's bounds, then the rates that must divide
 };
 
