@@ -8,7 +8,24 @@ namespace ddswarm::agent {
 
 namespace {
 constexpr const char* kJoinAgain = "leaving DDS and joining again as a new participant";
+
+/// What a participant without a scene heard of servers: the words that tell
+/// a user whether discovery, the handshake or the scene's writer is missing.
+std::string what_was_heard(const JoinView& v) {
+  if (v.servers.empty()) return "no server announced itself to this participant";
+  const ServerPeer& s = *std::max_element(
+      v.servers.begin(), v.servers.end(),
+      [](const ServerPeer& a, const ServerPeer& b) { return a.announced_s < b.announced_s; });
+  std::string heard = fmt::format("a server announced itself {:.1f} s ago", s.announced_s);
+  if (v.secure)
+    heard += s.authenticated_after_s >= 0
+                 ? fmt::format(" and authenticated it {:.1f} s later", s.authenticated_after_s)
+                 : std::string(" and has not authenticated it");
+  heard += v.scene_writer_matched ? "; its scene writer is matched"
+                                  : "; its scene writer is not matched";
+  return heard;
 }
+}  // namespace
 
 double JoinPatience::deaf_s(bool secure) const {
   return secure ? std::max(2 * lease_s, handshake_timeout_s) : 2 * lease_s;
@@ -89,8 +106,9 @@ std::optional<JoinVerdict> why_join_again(const JoinView& v, const JoinPatience&
   // at once (docs/performance.md); a new participant is discovered afresh.
   // No scene also means no mission to lose.
   if (!v.has_scene && p.scene_wait_s > 0 && v.now_s - v.joined_s > p.scene_wait_s)
-    return JoinVerdict{JoinEnd::kNoScene,
-                       fmt::format("no scene within {:.1f} s; {}", p.scene_wait_s, kJoinAgain)};
+    return JoinVerdict{JoinEnd::kNoScene, fmt::format("no scene within {:.1f} s ({}); {}",
+                                                      p.scene_wait_s, what_was_heard(v),
+                                                      kJoinAgain)};
   return std::nullopt;
 }
 

@@ -164,7 +164,21 @@ TEST(JoinWatch, NoSceneWithinTheWaitEndsTheJoinUnlessTheWaitIsOff) {
   ASSERT_TRUE(verdict);
   EXPECT_EQ(verdict->end, JoinEnd::kNoScene);
   EXPECT_EQ(verdict->why,
-            "no scene within 40.0 s; leaving DDS and joining again as a new participant");
+            "no scene within 40.0 s (no server announced itself to this participant); leaving "
+            "DDS and joining again as a new participant");
+  // What it heard tells discovery, the handshake and the scene's writer apart.
+  JoinView heard = joining(40.1);
+  heard.secure = true;
+  heard.servers = {{false, 2.0, 0.5}, {false, 38.0, 1.5}};
+  EXPECT_EQ(why_join_again(heard, patience())->why,
+            "no scene within 40.0 s (a server announced itself 38.0 s ago and authenticated it "
+            "1.5 s later; its scene writer is not matched); leaving DDS and joining again as a "
+            "new participant");
+  heard.secure = false;
+  heard.scene_writer_matched = true;
+  EXPECT_EQ(why_join_again(heard, patience())->why,
+            "no scene within 40.0 s (a server announced itself 38.0 s ago; its scene writer is "
+            "matched); leaving DDS and joining again as a new participant");
   JoinPatience off = patience();
   off.scene_wait_s = 0;  // agent.rejoin_after_s: 0
   EXPECT_FALSE(why_join_again(joining(1e6), off));
