@@ -106,9 +106,9 @@ std::optional<JoinVerdict> why_join_again(const JoinView& v, const JoinPatience&
   // at once (docs/performance.md); a new participant is discovered afresh.
   // No scene also means no mission to lose.
   if (!v.has_scene && p.scene_wait_s > 0 && v.now_s - v.joined_s > p.scene_wait_s)
-    return JoinVerdict{JoinEnd::kNoScene, fmt::format("no scene within {:.1f} s ({}); {}",
-                                                      p.scene_wait_s, what_was_heard(v),
-                                                      kJoinAgain)};
+    return JoinVerdict{JoinEnd::kNoScene,
+                       fmt::format("no scene within {:.1f} s ({}); {}", p.scene_wait_s,
+                                   what_was_heard(v), kJoinAgain)};
   return std::nullopt;
 }
 
