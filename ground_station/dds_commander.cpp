@@ -497,7 +497,10 @@ bool DdsCommander::wait_agent_statuses(double timeout_s) {
   auto& I = *impl_;
   std::unique_lock<std::mutex> lock(I.mu);
   return I.cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
-    return I.sim && I.agents.size() >= static_cast<std::size_t>(I.sim->num_drones());
+    if (!I.sim) return false;
+    for (auto id : I.sim->live_agents())
+      if (!I.agents.count(id)) return false;
+    return true;
   });
 }
 

@@ -137,7 +137,9 @@ class DdsCommander final : public Commander {
   /// one. False on timeout (e.g. no task was ever run).
   bool wait_task_status(double timeout_s);
   /// Waits up to timeout_s until a heartbeat (AgentStatus) was heard from
-  /// every drone of the server's scenario; false when some were not.
+  /// every agent the server's latest status lists live (a station that has
+  /// just joined meets the agents one by one; a dead agent is not waited
+  /// for); false when some were not.
   bool wait_agent_statuses(double timeout_s);
   SwarmStatus status() override;
   /// Every drone as the latest swarm state shows it (the first call waits up

@@ -49,6 +49,8 @@ class FakeSwarm {
     thread_.join();
   }
   void server_hears(int n) { server_hears_ = n; }
+  /// Heartbeats only from drones first..5 (those below: not yet met, or dead).
+  void heartbeats_from(int first) { heartbeats_from_ = first; }
 
  private:
   void publish() {
@@ -59,9 +61,10 @@ class FakeSwarm {
       if (i >= kDrones - server_hears_) s.live_agents().push_back(static_cast<std::uint16_t>(i));
     s.agents_live(static_cast<std::uint16_t>(s.live_agents().size()));
     w_status_.write(s);
-    for (int i = 0; i < kDrones; ++i) {
+    for (int i = heartbeats_from_; i < kDrones; ++i) {
       msg::AgentStatus a;
       a.drone_id(static_cast<std::uint16_t>(i));
+      a.law(i >= 3 ? "reynolds" : "thesis");
       a.host("fake");
       a.pid(static_cast<std::uint32_t>(::getpid()));  // one process: one ack writer to match
       w_agent_.write(a);
@@ -74,6 +77,7 @@ class FakeSwarm {
   Writer<msg::AgentStatus> w_agent_;
   Writer<msg::MissionAck> w_ack_;
   std::atomic<int> server_hears_{0};
+  std::atomic<int> heartbeats_from_{0};
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
@@ -100,6 +104,43 @@ TEST(DdsCommander, WaitsForTheServerToHearEveryAgentNotOnlyItself) {
   swarm.server_hears(6);
   EXPECT_TRUE(gs.wait_for_online(6, 10.0));
   EXPECT_TRUE(gs.wait_for_swarm(6, 10.0));
+}
+
+// `ddswarm-gs status` is a new participant: it meets the agents one by one,
+// and on a loaded machine a second after the server's status it had heard
+// only drones 3-5, so a mixed swarm's status named one law. It waits for every
+// agent the server hears live, and not for one the server does not.
+TEST(DdsCommander, StatusWaitsForEveryLiveAgentsHeartbeat) {
+  DdsConfig cfg;
+  cfg.domain_id = random_test_domain();
+  {
+    FakeSwarm swarm(cfg);
+    swarm.server_hears(6);
+    swarm.heartbeats_from(3);  // drones 0-2 not yet met
+    DdsCommander gs(GroundStationConfig{}, cfg);
+    ASSERT_TRUE(gs.wait_for_status(10.0));
+    EXPECT_FALSE(gs.wait_agent_statuses(0.5));
+    std::thread meet([&] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+      swarm.heartbeats_from(0);
+    });
+    const double t0 = wall_seconds();
+    EXPECT_TRUE(gs.wait_agent_statuses(10.0));
+    meet.join();
+    EXPECT_EQ(gs.status().laws, "3 reynolds, 3 thesis");
+    EXPECT_GE(wall_seconds() - t0, 1.0);
+  }
+  // Drone 0's agent is dead: the server does not list it, and the wait does
+  // not sit out its timeout for it.
+  FakeSwarm swarm(cfg);
+  swarm.server_hears(5);
+  swarm.heartbeats_from(1);
+  DdsCommander gs(GroundStationConfig{}, cfg);
+  ASSERT_TRUE(gs.wait_for_status(10.0));
+  const double t1 = wall_seconds();
+  EXPECT_TRUE(gs.wait_agent_statuses(10.0));
+  EXPECT_LT(wall_seconds() - t1, 5.0);
+  EXPECT_EQ(gs.status().laws, "3 reynolds, 2 thesis");
 }
 
 // A take-off ends for an agent once either word has it past the climb. A

@@ -319,12 +319,12 @@ class GroundStation {
 
   py::dict status(double timeout_s) {
     check_range("timeout", timeout_s, 0.0, 86400.0);
-    // As `ddswarm-gs status`: the latched task status, then a second of
-    // heartbeats for every agent's phase and law.
-    blocking(timeout_s + 3, [&] {
+    // As `ddswarm-gs status`: the latched task status, then a heartbeat from
+    // every agent the server hears live (its phase and law).
+    blocking(timeout_s + 9, [&] {
       if (live().wait_for_status(timeout_s)) {
         live().wait_task_status(std::min(timeout_s, 1.0));
-        live().wait_agent_statuses(1.0);
+        live().wait_agent_statuses(std::min(timeout_s, 5.0));
       }
       return 0;
     });
