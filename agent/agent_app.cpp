@@ -274,6 +274,7 @@ struct AgentApp::Impl {
     // Deleting the reader takes that lock as well: where Fast DDS throws, this
     // agent starts again (restart_on_dead_owner_lock), here as on Fast DDS's
     // own threads. A sound reader is made anew in a moment.
+    const StuckGuard stuck("making the swarm-state reader anew", kDdsStepStuckS);
     if (states) {
       try {
         dds.remove(*states);

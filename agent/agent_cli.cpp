@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <memory>
 
 #include "agent/rejoin_policy.hpp"
 #include "common/cli_checks.hpp"
@@ -79,12 +80,19 @@ int run_agent(const AgentAppConfig& cfg, double duration_s, int argc, char** arg
     RejoinPolicy policy(cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
                         cfg.dds.shared_memory && cfg.dds.shm_transport && !cfg.dds.secure(),
                         cfg.agent.handshake_timeout_s);
+    if (dead_owner_lock_restarts() > 0) policy.started_again();
     keep_joining(duration_s, [&](double left) {
       auto join = cfg;  // the user's configuration stays as given
       join.agent.rejoin_after_s = policy.scene_wait_s();
       join.agent.handshake_timeout_s = policy.handshake_wait_s();
       if (!policy.shm_transport()) join.dds.shm_transport = false;
-      AgentApp agent(join);
+      // Fast DDS 2.9 can deadlock this thread as it makes the participant's
+      // readers; the process then starts again (StuckGuard).
+      auto made = [&] {
+        const StuckGuard stuck("joining DDS", kDdsStepStuckS + join.duplicate_probe_s);
+        return std::make_unique<AgentApp>(join);
+      }();
+      AgentApp& agent = *made;
       const auto end = agent.run(left);
       const bool cut_off = end == AgentApp::End::kUnheard || end == AgentApp::End::kDeaf;
       if (policy.ended(cut_off, end == AgentApp::End::kNoScene, agent.heard_scene(),

@@ -42,6 +42,11 @@ class RejoinPolicy {
   /// shared-memory ports whose files a stall made anew and removed, which
   /// no new sender reaches, while UDP reaches it (docs/dds.md).
   bool ended(bool cut_off, bool no_scene, bool heard_scene, bool handshake_stall = false);
+  /// This process was started again (restart_on_dead_owner_lock) while it
+  /// flew in a swarm: its first join is a re-join after one that had the
+  /// scene, so it waits kRejoinedSceneLeases leases for the scene, not the
+  /// start-up wait (40-60 s, longer than a ground station waits for it).
+  void started_again() { had_scene_ = true; }
 
  private:
   double rejoin_after_s_, lease_s_, handshake_s_;

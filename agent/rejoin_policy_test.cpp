@@ -33,6 +33,19 @@ TEST(RejoinPolicy, AnUnheardOrDeafAgentJoinsWithoutSharedMemory) {
   EXPECT_FALSE(p.ended(true, false, true)) << "said once";
 }
 
+// mp_fault_server_lock_kill: the agent whose lock the killed server held
+// starts again as the same process. Its first join waited the start-up 40-60 s
+// for the new server's scene, past the 60 s the test's ground station waits;
+// it waits 4 leases, and when no scene comes, it joins again over UDP.
+TEST(RejoinPolicy, AProcessStartedAgainWaitsLeasesForTheScene) {
+  RejoinPolicy p(40.0, 3.0, true);
+  p.started_again();
+  EXPECT_DOUBLE_EQ(p.scene_wait_s(), 12.0);
+  EXPECT_TRUE(p.shm_transport());
+  EXPECT_TRUE(p.ended(false, true, false)) << "no scene from the new server";
+  EXPECT_FALSE(p.shm_transport());
+}
+
 // At start-up (no scene yet) a join that heard none is a slow discovery, not
 // a lost port: it keeps shared memory and waits twice as long each time.
 TEST(RejoinPolicy, NoSceneAtStartUpKeepsSharedMemory) {

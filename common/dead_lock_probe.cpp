@@ -2,10 +2,13 @@
 // "run <restarts> pid <pid> fds <descriptors above 2>", then, unless it has
 // been started again and argv[1] is "lock-once", throws on a thread of its
 // own as Fast DDS's threads do: the dead owner's lock timeout for "lock-once"
-// and "lock-always", anything else for "other". argv[2]: max restarts.
+// and "lock-always", anything else for "other". "stuck-once" and
+// "stuck-always" instead never end a step a StuckGuard of 0.3 s guards.
+// argv[2]: max restarts.
 #include <dirent.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -35,7 +38,11 @@ int main(int argc, char** argv) {
   const int runs = ddswarm::dead_owner_lock_restarts();
   std::printf("run %d pid %d fds %d\n", runs, static_cast<int>(getpid()), open_fds_above_2());
   std::fflush(stdout);
-  if (mode == "lock-once" && runs >= 1) return 0;
+  if ((mode == "lock-once" || mode == "stuck-once") && runs >= 1) return 0;
+  if (mode.rfind("stuck", 0) == 0) {
+    const ddswarm::StuckGuard guard("joining DDS", 0.3);
+    for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));  // as a deadlocked thread
+  }
   std::thread([&] {
     throw std::runtime_error(mode == "other" ? "an unrelated failure"
                                              : "Interprocess mutex timeout when locking. Possible "

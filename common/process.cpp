@@ -186,6 +186,9 @@ std::int64_t monotonic_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
+void start_again(DeadLockRestart& r, const std::string& what, const std::string& cause,
+                 const std::string& detail);
+
 // Execs this program again if the exception in flight is the dead owner's
 // lock timeout and the count allows; returns only when it did not.
 void try_dead_lock_restart(DeadLockRestart& r) {
@@ -200,21 +203,27 @@ void try_dead_lock_restart(DeadLockRestart& r) {
     return;
   }
   if (!is_dead_owner_lock_timeout(what.c_str())) return;
+  start_again(r, "a Fast DDS thread met a shared-memory lock whose owner died",
+              ", a peer killed while holding it", " (" + what + ")");
+}
+
+// Execs this program again, saying why (what, then detail: a cause for the
+// line that restarts, and what happened), unless max_restarts in a row were
+// made already; returns only when it did not.
+void start_again(DeadLockRestart& r, const std::string& what, const std::string& cause,
+                 const std::string& detail) {
   const std::int64_t now = monotonic_ns();
   const int n = next_dead_lock_restart(std::getenv(kDeadLockRestartsEnv), now);
   if (n > r.max_restarts) {
-    spdlog::error(
-        "{}: a Fast DDS thread met a shared-memory lock whose owner died ({}); {} restarts in "
-        "a row already, so not again",
-        r.prog, what, r.max_restarts);
+    spdlog::error("{}: {}{}; {} restarts in a row already, so not again", r.prog, what, detail,
+                  r.max_restarts);
     spdlog::default_logger()->flush();
     return;
   }
   spdlog::error(
-      "{}: a Fast DDS thread met a shared-memory lock whose owner died, a peer killed while "
-      "holding it ({}); starting this process again as a new participant, the same pid "
-      "({} of {} in a row)",
-      r.prog, what, n, r.max_restarts);
+      "{}: {}{}{}; starting this process again as a new participant, the same pid ({} of {} in "
+      "a row)",
+      r.prog, what, cause, detail, n, r.max_restarts);
   spdlog::default_logger()->flush();
   std::fflush(nullptr);
   const std::string count = std::to_string(n) + ":" + std::to_string(now);
@@ -277,6 +286,40 @@ void restart_on_dead_owner_lock(const char* prog, int argc, char** argv, int max
   r.args.assign(argv, argv + argc);
   r.max_restarts = max_restarts;
   r.previous = std::set_terminate(on_terminate);
+}
+
+struct StuckGuard::State {
+  std::mutex mu;
+  std::condition_variable cv;
+  bool done = false;
+};
+
+StuckGuard::StuckGuard(std::string step, double timeout_s) {
+  if (dead_lock_restart().args.empty()) return;  // restart_on_dead_owner_lock not called
+  state_ = std::make_shared<State>();
+  // Detached: a step that ends lets it go at once, and a stuck one is never
+  // joined (the exec ends every thread).
+  std::thread([st = state_, step = std::move(step), timeout_s] {
+    std::unique_lock<std::mutex> lock(st->mu);
+    if (st->cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return st->done; }))
+      return;
+    auto& r = dead_lock_restart();
+    if (r.entered.exchange(true)) return;  // a dead lock's restart is under way
+    start_again(r, fmt::format("{} has not ended in {:g} s", step, timeout_s),
+                ": a thread of Fast DDS's is stuck (a deadlock of Fast DDS 2.9's, docs/faults.md)",
+                "");
+    std::fflush(nullptr);
+    std::_Exit(1);  // not again, or the exec failed: end rather than hang
+  }).detach();
+}
+
+StuckGuard::~StuckGuard() {
+  if (!state_) return;
+  {
+    const std::lock_guard<std::mutex> lock(state_->mu);
+    state_->done = true;
+  }
+  state_->cv.notify_all();
 }
 
 int run_main(const char* prog, const std::function<int()>& body) {

@@ -147,6 +147,28 @@ TEST(DeadLockRestart, StopsStartingAgainAfterItsRestartsInARow) {
   EXPECT_NE(r.out.find("so not again"), std::string::npos) << r.out;
 }
 
+// mp_fault_server_lock_kill under load: the agent started again, and its
+// main thread deadlocked in Fast DDS creating a reader (against the lease
+// timer's thread) and logged nothing for a minute. A step that does not end
+// starts the process again, counted with the dead-lock restarts.
+TEST(StuckGuard, AStepThatNeverEndsStartsTheProcessAgain) {
+  const ProbeRun r = run_probe("stuck-once", 3);
+  ASSERT_TRUE(WIFEXITED(r.status) && WEXITSTATUS(r.status) == 0) << r.out;
+  const Runs runs = runs_of(r.out);
+  ASSERT_EQ(runs.pids.size(), 2u) << r.out;
+  EXPECT_EQ(runs.pids[0], runs.pids[1]) << r.out;
+  EXPECT_NE(r.out.find("joining DDS has not ended in 0.3 s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 of 3 in a row"), std::string::npos) << r.out;
+}
+
+// Past its restarts in a row it ends (exit 1) rather than hang.
+TEST(StuckGuard, EndsTheProcessAfterItsRestartsInARow) {
+  const ProbeRun r = run_probe("stuck-always", 1);
+  EXPECT_TRUE(WIFEXITED(r.status) && WEXITSTATUS(r.status) == 1) << r.out;
+  EXPECT_EQ(runs_of(r.out).pids.size(), 2u) << r.out;
+  EXPECT_NE(r.out.find("so not again"), std::string::npos) << r.out;
+}
+
 TEST(DeadLockRestart, AnyOtherUncaughtExceptionEndsTheProcessAsBefore) {
   const ProbeRun r = run_probe("other", 3);
   EXPECT_TRUE(WIFSIGNALED(r.status) && WTERMSIG(r.status) == SIGABRT) << r.out;
