@@ -60,6 +60,14 @@ kill -0 "$PID_agents" 2>/dev/null || fail "the launcher stopped the swarm: an ag
 [ "$(pgrep -f -- "ddswarm-agent .*--domain $DOMAIN\b" | sort)" = "$agent_pids" ] ||
   fail "the agent processes are not the same ones"
 grep -h "owner died\|joining again" "$WORK"/agent_*.log || true
+# An agent the new server's first seconds left deaf (it stalls 1 s per write
+# on the dead lock until the old participant's lease ends) makes its reader
+# anew 4 s later (agent.server_timeout_s above), then acknowledges: the
+# ground station's 5 s ack timeout ended 2.6 s after such a renewal in 1 run
+# of 20 under two busy loops. It waits 15 s.
+sed 's/^  ack_timeout_s: .*/  ack_timeout_s: 15.0/' "$scenario" >"$WORK/patient_gs.yaml"
+grep -q "ack_timeout_s: 15.0" "$WORK/patient_gs.yaml" || fail "cannot derive patient_gs.yaml"
+gs() { timeout 60 "$BIN/ddswarm-gs" --config "$WORK/patient_gs.yaml" --domain "$DOMAIN" "$@"; }
 gs takeoff --wait || fail "takeoff with the new server"
 gs status | tee "$WORK/status.txt"
 grep -q "6 airborne" "$WORK/status.txt" || fail "the swarm did not take off with the new server"
