@@ -506,27 +506,13 @@ Participant::~Participant() {
   fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
 }
 
-namespace {
-[[maybe_unused]] std::atomic<bool> g_leave_without_goodbye{false};
-}  // namespace
-
-bool leave_without_goodbye() {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  return false;
-#else
-  g_leave_without_goodbye = true;
-  return true;
-#endif
-}
-
 int end_process(int code) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   return code;
 #else
   auto* factory = fdds::DomainParticipantFactory::get_instance();
-  if (!g_leave_without_goodbye)
-    for (int d = 0; d <= kMaxDomainId; ++d)
-      if (!factory->lookup_participants(static_cast<fdds::DomainId_t>(d)).empty()) return code;
+  for (int d = 0; d <= kMaxDomainId; ++d)
+    if (!factory->lookup_participants(static_cast<fdds::DomainId_t>(d)).empty()) return code;
   spdlog::shutdown();
   fdds::Log::Flush();
   std::cout.flush();

@@ -66,12 +66,6 @@ std::uint64_t handler_throws();
 /// normal exit, in which that destructor deletes it and tells its peers.
 /// Sanitizer builds return code too: their checks run at exit.
 int end_process(int code);
-/// From now on end_process ends the process at once even with participants
-/// open, so that they send no goodbye (their peers drop them when their
-/// lease ends); a process that calls it keeps the participants it will not
-/// close open until then, with their listeners. False in sanitizer builds,
-/// whose leak checks run at exit: there the participants close as before.
-bool leave_without_goodbye();
 
 template <class T>
 class Writer {

@@ -195,14 +195,7 @@ int run_gs(CLI::App& app, GsCommandLine& cl) {
   // Status needs only the clock (a replayed recording has no server to command).
   bool ready = false;
   auto commander = join_swarm(file, *cl.status || (*cl.task && cl.attach), ready);
-  // A one-shot command leaves without a goodbye: its participant stays open
-  // until the process ends (end_process), and each peer drops it when its
-  // lease ends, by its lease timer alone. A goodbye that arrives as a peer's
-  // lease check for it fires aborts that peer in Debian's Fast DDS 2.9.1
-  // (PDP.cpp:1140, docs/dds.md), and a command that lives past its 20 s
-  // lease (wait-agents, task, takeoff --wait) is checked by every peer.
-  const bool silent = !interactive && leave_without_goodbye();
-  DdsCommander& gs = silent ? *commander.release() : *commander;
+  DdsCommander& gs = *commander;
   if (!ready && !interactive) {
     if (stop_requested()) return 1;  // interrupted while discovering: reported below
     const ServerSearch s = gs.server_search();
