@@ -110,6 +110,11 @@ void restart_on_dead_owner_lock(const char* prog, int argc, char** argv, int max
 /// started this process again when it began (0: its first start).
 int dead_owner_lock_restarts();
 
+/// A DDS step (a participant with its endpoints, a reader made anew) that
+/// takes longer than this is stuck: such steps take well under a second, and
+/// a few seconds for 128 processes starting at once on 2 cores.
+constexpr double kDdsStepStuckS = 20.0;
+
 /// Starts this process again, as restart_on_dead_owner_lock does and counted
 /// with its restarts, when the step it guards has not ended within
 /// timeout_s: Fast DDS 2.9 can deadlock a thread that creates a reader
@@ -118,11 +123,6 @@ int dead_owner_lock_restarts();
 /// holds), and neither ever returns (docs/faults.md). Past max_restarts in a
 /// row the process ends with exit code 1 rather than hang. Inert unless
 /// restart_on_dead_owner_lock was called. Destroy it when the step ended.
-/// A DDS step (a participant with its endpoints, a reader made anew) that
-/// takes longer than this is stuck: such steps take well under a second, and
-/// a few seconds for 128 processes starting at once on 2 cores.
-constexpr double kDdsStepStuckS = 20.0;
-
 class StuckGuard {
  public:
   StuckGuard(std::string step, double timeout_s);
@@ -134,6 +134,7 @@ class StuckGuard {
   struct State;
   std::shared_ptr<State> state_;
 };
+
 /// Whether an exception's what() is Fast DDS's lock timeout on a dead owner.
 bool is_dead_owner_lock_timeout(const char* what);
 /// Restarts further apart than this (s) start the count again.

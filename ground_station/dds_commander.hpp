@@ -86,6 +86,11 @@ ServerSearch server_search(const std::vector<ServerPeer>& servers, bool secure, 
 /// the default 10 s; a handshake Fast DDS leaves pending for good stops here.
 constexpr double kServerComingUpS = 120.0;
 
+/// s: the longest a status waits for the heartbeat of every agent the server
+/// hears live (DdsCommander::wait_agent_statuses): a station that has just
+/// joined meets the agents one by one, seconds apart on a loaded machine.
+constexpr double kAgentHeartbeatsWaitS = 5.0;
+
 class DdsCommander final : public Commander {
  public:
   DdsCommander(const GroundStationConfig& cfg, const DdsConfig& dds);

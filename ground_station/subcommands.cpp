@@ -417,10 +417,8 @@ int wait_agents_command(DdsCommander& gs, int wait_count, double wait_timeout) {
 
 int status_command(DdsCommander& gs, const GsFileConfig& file, bool status_drones) {
   gs.wait_task_status(file.gs.discovery_timeout_s);  // latched: follows the match when there is one
-  // Heartbeats come 4 times a second, once this new participant has met
-  // each agent: wait until every agent the server hears live was heard (its
-  // phase, law and law fault), for at most 5 s on a loaded machine.
-  gs.wait_agent_statuses(std::min(file.gs.discovery_timeout_s, 5.0));
+  // Every live agent's phase, law and law fault, from its heartbeat.
+  gs.wait_agent_statuses(std::min(file.gs.discovery_timeout_s, kAgentHeartbeatsWaitS));
   const SwarmStatus st = gs.status();
   std::printf("%s\n%s\n", format_status(st).c_str(), format_rejections(st).c_str());
   if (const std::string c = format_commands(st); !c.empty()) std::printf("%s\n", c.c_str());

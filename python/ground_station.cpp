@@ -321,10 +321,10 @@ class GroundStation {
     check_range("timeout", timeout_s, 0.0, 86400.0);
     // As `ddswarm-gs status`: the latched task status, then a heartbeat from
     // every agent the server hears live (its phase and law).
-    blocking(timeout_s + 9, [&] {
+    blocking(timeout_s + 1.0 + gs::kAgentHeartbeatsWaitS + 3, [&] {
       if (live().wait_for_status(timeout_s)) {
         live().wait_task_status(std::min(timeout_s, 1.0));
-        live().wait_agent_statuses(std::min(timeout_s, 5.0));
+        live().wait_agent_statuses(std::min(timeout_s, gs::kAgentHeartbeatsWaitS));
       }
       return 0;
     });

@@ -36,11 +36,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     const bool plausible = copy_scene || bad_scene;  // the states that follow a scene
     install_stop_signals();
-    // A few seconds' attack is a one-shot participant: at the 3 s lease it
-    // would leave as its peers' first lease check fires, a race that aborts
-    // them in Debian's Fast DDS 2.9.1 (kOneShotLeaseS; an agent of bench/soak.sh's
-    // 64 did so).
-    dds = one_shot(dds);
+    dds = one_shot(dds);  // a few seconds' attack: kOneShotLeaseS says why
     Participant p(dds, "forger");
     auto w = p.writer<msg::SwarmState>();
     std::mutex mu;

@@ -100,11 +100,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     install_stop_signals();
 
-    // A few seconds' attack is a one-shot participant: at the 3 s lease it
-    // would leave as its peers' first lease check fires, a race that aborts
-    // them in Debian's Fast DDS 2.9.1 (kOneShotLeaseS; an agent of bench/soak.sh's
-    // 64 did so).
-    dds = one_shot(dds);
+    dds = one_shot(dds);  // a few seconds' attack: kOneShotLeaseS says why
     Participant p(dds, "hostile_publisher");
     auto w_cmd = p.writer<msg::VelocityCommand>();
     auto w_hb = p.writer<msg::AgentStatus>();

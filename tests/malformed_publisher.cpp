@@ -90,11 +90,7 @@ int main(int argc, char** argv) {
     install_stop_signals();
 
     // The project's own writers, for their QoS and partitions (never written).
-    // A few seconds' attack is a one-shot participant: at the 3 s lease it
-    // would leave as its peers' first lease check fires, a race that aborts
-    // them in Debian's Fast DDS 2.9.1 (kOneShotLeaseS; an agent of bench/soak.sh's
-    // 64 did so).
-    dds = one_shot(dds);
+    dds = one_shot(dds);  // a few seconds' attack: kOneShotLeaseS says why
     Participant model(dds, "malformed_publisher_model");
     auto w_cmd = model.writer<msg::VelocityCommand>();
     auto w_hb = model.writer<msg::AgentStatus>();
