@@ -20,7 +20,7 @@
 #include "common/scenario_check.hpp"
 #include "common/scene.hpp"
 #include "experiment/report.hpp"
-#include "ground_station/gs_app.hpp"
+#include "ground_station/gs_file_config.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/preflight.hpp"
 
@@ -321,17 +321,10 @@ RunStart start_and_fly(const RunPlan& p, int starts, int domain, const std::stri
 
 /// A run's CSV row: its plan's, with how its last start ended.
 RunRecord finished_record(RunRecord rec, const RunStart& r, double run_start) {
-  const TaskOutcome& o = r.o;
-  rec.ok = o.ok && r.died.empty();
-  rec.failure_reason = !r.died.empty() ? r.died : o.reason;
-  rec.task_time_s = o.ok ? o.task_time_s : std::nan("");
+  rec = with_outcome(std::move(rec), r.o);
+  rec.ok = r.o.ok && r.died.empty();
+  if (!r.died.empty()) rec.failure_reason = r.died;
   rec.wall_time_s = wall_seconds() - run_start;
-  rec.collisions_obstacle = o.collisions_obstacle;
-  rec.collisions_drone = o.collisions_drone;
-  rec.collisions_ground = o.collisions_ground;
-  rec.min_inter_drone_m = o.min_inter_drone_m;
-  rec.min_clearance_m = o.min_clearance_m;
-  rec.metrics = o.metrics;
   return rec;
 }
 
@@ -442,6 +435,20 @@ int report_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt,
 }
 
 }  // namespace
+
+RunRecord with_outcome(RunRecord rec, const TaskOutcome& o) {
+  rec.ok = o.ok;
+  rec.failure_reason = o.reason;
+  rec.task_time_s = o.ok ? o.task_time_s : std::nan("");
+  rec.wall_time_s = o.wall_time_s;
+  rec.collisions_obstacle = o.collisions_obstacle;
+  rec.collisions_drone = o.collisions_drone;
+  rec.collisions_ground = o.collisions_ground;
+  rec.min_inter_drone_m = o.min_inter_drone_m;
+  rec.min_clearance_m = o.min_clearance_m;
+  rec.metrics = o.metrics;
+  return rec;
+}
 
 int run_experiment(const ExperimentConfig& cfg, const ExperimentOptions& opt, std::ostream& out) {
   const std::string bin = opt.bin_dir.empty() ? Launcher::self_dir() : opt.bin_dir;

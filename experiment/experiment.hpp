@@ -7,6 +7,7 @@
 
 #include "common/dds_config.hpp"
 #include "experiment/experiment_config.hpp"
+#include "experiment/report.hpp"
 #include "ground_station/dds_commander.hpp"
 #include "ground_station/gs_config.hpp"
 
@@ -40,6 +41,10 @@ inline constexpr int kRunStarts = 3;
 inline bool start_run_again(const TaskOutcome& o, bool a_process_died, int starts) {
   return o.never_up && !a_process_died && starts < kRunStarts;
 }
+
+/// rec with a flown task's outcome: ok, failure reason, task and wall time,
+/// collisions, clearances and swarm metrics (the task time is NaN on failure).
+RunRecord with_outcome(RunRecord rec, const TaskOutcome& o);
 
 struct ExperimentOptions {
   std::string out_dir = "results";  ///< CSV, table, plots, per-run scenarios and logs go here

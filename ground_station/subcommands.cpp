@@ -221,17 +221,7 @@ void append_result(const std::string& csv, const TaskOutcome& o, int drones) {
   rec.seed = o.seed;
   rec.drones = drones;
   rec.speed_mps = o.speed_mps;
-  rec.ok = o.ok;
-  rec.failure_reason = o.reason;
-  rec.task_time_s = o.ok ? o.task_time_s : std::nan("");
-  rec.wall_time_s = o.wall_time_s;
-  rec.collisions_obstacle = o.collisions_obstacle;
-  rec.collisions_drone = o.collisions_drone;
-  rec.collisions_ground = o.collisions_ground;
-  rec.min_inter_drone_m = o.min_inter_drone_m;
-  rec.min_clearance_m = o.min_clearance_m;
-  rec.metrics = o.metrics;
-  append_csv(csv, rec);
+  append_csv(csv, with_outcome(std::move(rec), o));
 }
 
 int serve_web(const GsFileConfig& file, const std::string& addr, const std::string& root,

@@ -10,7 +10,7 @@
 
 #include "common/dds_config.hpp"
 #include "ground_station/dds_commander.hpp"
-#include "ground_station/gs_app.hpp"
+#include "ground_station/gs_file_config.hpp"
 
 namespace ddswarm::gs {
 

@@ -20,7 +20,7 @@
 #include "common/scenario.hpp"
 #include "common/scenario_overrides.hpp"
 #include "common/scene.hpp"
-#include "ground_station/gs_app.hpp"
+#include "ground_station/gs_file_config.hpp"
 #include "launcher/preflight.hpp"
 
 namespace ddswarm::gs {

@@ -17,7 +17,7 @@
 #include "common/dds_config.hpp"
 #include "common/domain_claim.hpp"
 #include "common/scenario_check.hpp"
-#include "ground_station/gs_app.hpp"
+#include "ground_station/gs_file_config.hpp"
 #include "launcher/launcher.hpp"
 
 namespace ddswarm::gs {

@@ -29,7 +29,7 @@
 #include "common/swarm_state_cdr.hpp"
 #include "common/topics.hpp"
 #include "ground_station/dds_commander.hpp"
-#include "ground_station/gs_app.hpp"
+#include "ground_station/gs_file_config.hpp"
 
 namespace py = pybind11;
 

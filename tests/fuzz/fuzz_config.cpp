@@ -11,7 +11,7 @@
 
 #include "agent/agent_app_config.hpp"
 #include "common/config_error.hpp"
-#include "ground_station/gs_app.hpp"
+#include "ground_station/gs_file_config.hpp"
 #include "sim_server/sim_server.hpp"
 
 namespace {

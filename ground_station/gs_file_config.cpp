@@ -1,4 +1,4 @@
-#include "ground_station/gs_app.hpp"
+#include "ground_station/gs_file_config.hpp"
 
 #include "common/scenario.hpp"
 
