@@ -51,6 +51,15 @@ PortRange ephemeral_port_range() {
 
 int max_participant_id(int domain_id) { return (65535 - 1 - rtps_unicast_port(domain_id, 0)) / 2; }
 
+std::vector<int> participant_ids_above_agents(int domain_id) {
+  constexpr int kAboveEveryAgent = kAgentParticipantIdBase + 1024;  // scenario.drones <= 1024
+  std::vector<int> ids;
+  for (int id = max_participant_id(domain_id);
+       id >= kAboveEveryAgent && static_cast<int>(ids.size()) < kAboveAgentsIds; --id)
+    ids.push_back(id);
+  return ids;
+}
+
 std::uint32_t agent_shm_segment_bytes(std::size_t drones) {
   const std::size_t bytes = (256u << 10) + drones * (16u << 10);
   return static_cast<std::uint32_t>(std::min<std::size_t>(bytes, kShmSegmentBytes));

@@ -40,6 +40,14 @@ int rtps_unicast_port(int domain_id, int participant_id);
 /// The largest RTPS participant id whose ports fit in domain_id (29062 at
 /// domain 0, 62 at domain 232). Fast DDS's automatic ids try only ~100.
 int max_participant_id(int domain_id);
+/// The participant ids, best first, of a participant that meets no agent
+/// (DdsConfig::meets_agents): the domain's highest, whose ports (61000 and up
+/// in domains 0-214) lie above the kernel's ephemeral range and every agent's
+/// id (kAgentParticipantIdBase + drone, drones < 1024); kAboveAgentsIds of
+/// them, for that many such participants at once. Empty when the domain's
+/// port range has no room above the agents'.
+std::vector<int> participant_ids_above_agents(int domain_id);
+inline constexpr int kAboveAgentsIds = 32;
 
 /// The kernel's ephemeral port range (/proc/sys/net/ipv4/ip_local_port_range):
 /// any process's outgoing socket may hold a port inside it. Empty ({0, -1})
@@ -157,6 +165,16 @@ struct DdsConfig {
   /// with each other would keep the swarm from ever coming up (docs/security.md).
   /// Set by the binary, not read from YAML.
   bool announce_to_tools_only = false;
+  /// false: never meet an agent (localhost discovery without shared memory,
+  /// so under DDS Security): announce to the server's and tools' ids only, as
+  /// agents do, from a participant id no agent announces to or takes (the top
+  /// of the domain's port range, above every agent's: participant_id_above_agents).
+  /// Ground stations set it under --secure: each one-shot command would
+  /// otherwise authenticate with every agent, N handshakes that at 64 drones
+  /// flood the server's and agents' discovery ports (docs/security.md). What
+  /// it knows of agents then comes from the server. Set by the binary, not
+  /// read from YAML.
+  bool meets_agents = true;
   std::string profiles_file = std::string(DDSWARM_CONFIG_DIR) + "/dds_profiles.xml";
   /// A newer sample supersedes a lost one. Writers keep their profile (reliable), so any reliable
   /// reader (recorder, ground station, web view, a process with false) still

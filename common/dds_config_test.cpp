@@ -144,5 +144,21 @@ TEST(DdsConfig, TheReferenceDescribesEveryFieldAsTheCodeDeclaresIt) {
             std::vector<std::string>{});
 }
 
+TEST(IdsAboveAgents, NoAgentTakesOrAnnouncesToThemAndTheirPortsAreValid) {
+  for (const int domain : {0, 30, 89, 200}) {
+    const auto ids = participant_ids_above_agents(domain);
+    ASSERT_EQ(ids.size(), static_cast<std::size_t>(kAboveAgentsIds)) << "domain " << domain;
+    EXPECT_EQ(ids.front(), max_participant_id(domain));  // the top one first
+    for (const int id : ids) {
+      EXPECT_GE(id, kAgentParticipantIdBase + 1024);  // above drone 1023's agent
+      EXPECT_LE(rtps_unicast_port(domain, id) + 1, 65535);
+    }
+  }
+  // Domain 0's lie above Linux's default ephemeral range (32768-60999).
+  EXPECT_GT(rtps_unicast_port(0, participant_ids_above_agents(0).back()), 60999);
+  // The last domain has no room above 1024 agents: such a participant meets them.
+  EXPECT_TRUE(participant_ids_above_agents(232).empty());
+}
+
 }  // namespace
 }  // namespace ddswarm

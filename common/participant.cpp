@@ -167,7 +167,7 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
       // Same-host discovery: SHM multicast plus unicast pings to 127.0.0.1,
       // to every id, or only to the server's and tools' (an agent's, where
       // unicast pings are all the discovery there is).
-      if (cfg.announce_to_tools_only && !uses_shared_memory(cfg)) {
+      if ((cfg.announce_to_tools_only || !cfg.meets_agents) && !uses_shared_memory(cfg)) {
         const int ids = std::min(kAgentParticipantIdBase, max_participant_id(cfg.domain_id) + 1);
         for (int id = 0; id < ids; ++id)
           wp.builtin.initialPeersList.push_back(
@@ -381,8 +381,33 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     // The watch hears discovery and authentication only (no data status):
     // every reader and writer keeps its own listener.
     peer_watch_ = std::make_unique<PeerWatch>();
-    participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
-                                               fdds::StatusMask::none());
+    // Above every agent's id, where no agent announces itself: the first one
+    // free (others of its kind may hold some).
+    if (!cfg.meets_agents && cfg.participant_id < 0 && cfg.discovery == Discovery::kLocalhost &&
+        !shared_memory_) {
+      bool all_taken = true;
+      for (const int id : participant_ids_above_agents(cfg.domain_id)) {
+        if (participant_id_taken_here(cfg.domain_id, id)) continue;
+        qos.wire_protocol().participant_id = id;
+        participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
+                                                   fdds::StatusMask::none());
+        // Not for want of its port (taken since the look): the error below says why.
+        if (participant_ || !participant_id_taken_here(cfg.domain_id, id)) {
+          all_taken = false;
+          break;
+        }
+      }
+      meets_agents_ = !participant_;
+      if (!participant_ && all_taken)
+        spdlog::warn(
+            "no participant id above the agents' is free on domain {}: this participant meets "
+            "every agent",
+            cfg.domain_id);
+      if (!participant_) qos.wire_protocol().participant_id = -1;
+    }
+    if (!participant_)
+      participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
+                                                 fdds::StatusMask::none());
     if (!participant_ && clear_id && qos.wire_protocol().participant_id >= 0) {
       qos.wire_protocol().participant_id =
           -1;  // e.g. the id is this process's already: Fast DDS picks

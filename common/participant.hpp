@@ -287,6 +287,10 @@ class Participant {
   /// data-sharing delivery): dds.shared_memory, and neither DDS Security nor
   /// the TSan build.
   bool shared_memory() const { return shared_memory_; }
+  /// false: no agent discovers this participant (DdsConfig::meets_agents, and
+  /// an id above the agents' was free); what it knows of agents comes from
+  /// the server.
+  bool meets_agents() const { return meets_agents_; }
 
  private:
   fdds::Publisher* publisher_for(const std::string& partition);
@@ -338,6 +342,7 @@ class Participant {
   // (dds.shared_memory false, DDS Security, the TSan build) Fast DDS's
   // data-sharing delivery, which also goes through /dev/shm, is off too.
   bool shared_memory_ = false;
+  bool meets_agents_ = true;
   std::string role_;
   fdds::Publisher* publisher_ = nullptr;
   fdds::Subscriber* subscriber_ = nullptr;
