@@ -102,22 +102,6 @@ std::optional<JoinVerdict> why_join_again(const JoinView& v, const JoinPatience&
                                      s.announced_s, kJoinAgain)};
     }
   }
-  // Authenticated, yet the server's scene writer never matched: the secure
-  // endpoint discovery that follows the handshake was lost (a 64-drone
-  // secure bring-up had it come 10-14 s after the handshake, and an agent
-  // that lost it waited out its whole scene wait). Twice the handshake's
-  // wait, which doubles for each such join in a row.
-  if (!v.has_scene && v.secure && p.handshake_wait_s > 0 && !v.scene_writer_matched) {
-    for (const auto& s : v.servers) {
-      const double since = s.announced_s - s.authenticated_after_s;
-      if (s.authenticated_after_s < 0 || since <= 2 * p.handshake_wait_s) continue;
-      return JoinVerdict{JoinEnd::kHandshakeStall,
-                         fmt::format("the server authenticated this participant {:.1f} s ago "
-                                     "and its scene writer has not matched: the secure endpoint "
-                                     "discovery did not end; {}",
-                                     since, kJoinAgain)};
-    }
-  }
   // Fast DDS 2.9 sometimes never matches one of 128 participants that start
   // at once (docs/performance.md); a new participant is discovered afresh.
   // No scene also means no mission to lose.
