@@ -37,6 +37,7 @@ bool is_local_address(const std::string& ip) {
 void load(YamlSection s, DdsConfig& c) {
   FieldLoader load(s);
   DdsConfig::fields(c, load);
+  c.lease_named = s.has("lease_duration_s");
   s.finish();
 }
 
@@ -222,5 +223,11 @@ void merge_cli(DdsConfig& target, const DdsConfig& cli, const CLI::App& app) {
   if (app.count("--best-effort-streams")) target.best_effort_streams = cli.best_effort_streams;
   if (app.count("--secure")) target.security_dir = cli.security_dir;
   if (app.count("--security-role")) target.security_role = cli.security_role;
+  secure_lease(target);
+}
+
+void secure_lease(DdsConfig& c) {
+  if (c.secure() && c.discovery == Discovery::kLocalhost && !c.lease_named)
+    c.lease_duration_s = kSecureLeaseS;
 }
 }  // namespace ddswarm

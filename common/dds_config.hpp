@@ -74,6 +74,14 @@ constexpr int kAgentParticipantIdBase = 32;
 /// on it.
 constexpr double kDiscoveryServerLeaseS = 20.0;
 
+/// The lease of every participant under DDS Security on one host, unless the
+/// scenario names dds.lease_duration_s (secure_lease). A secure bring-up keeps
+/// both cores busy with handshakes: at 3 s, 64-agent launches lost agents'
+/// leases, made 0-46 agents join again, and in 1 of 5 hung the server in a
+/// Fast DDS 2.9 deadlock (a goodbye and a lapsed lease removed at once,
+/// docs/security.md); at 20 s, 5 of 5 came up in 17-20 s, none joining again.
+constexpr double kSecureLeaseS = 20.0;
+
 /// The least lease a one-shot ground-station command announces (every
 /// ddswarm-gs subcommand but the console, and each experiment run's ground
 /// station; see one_shot). Each peer checks a participant's
@@ -145,6 +153,8 @@ struct DdsConfig {
   /// max_participant_id(domain_id): the RTPS ports must fit.
   int participant_id = -1;
   double lease_duration_s = 3.0;
+  /// The scenario names dds.lease_duration_s (set by load; secure_lease keeps it).
+  bool lease_named = false;
   /// Fast DDS's healthy_check_timeout (1 s by default there). Fast DDS 2.9
   /// makes ports anew with races that can leave a live process listening on
   /// a port no sender reaches any more (docs/dds.md), so ddswarm keeps stalls
@@ -251,4 +261,8 @@ namespace ddswarm {
 /// Copies into target the DDS options the user actually gave on the command
 /// line (cli was bound with add_dds_options), so flags override the YAML.
 void merge_cli(DdsConfig& target, const DdsConfig& cli, const CLI::App& app);
+/// Under DDS Security with localhost discovery, kSecureLeaseS unless the
+/// scenario names a lease. merge_cli applies it; so must whatever else sets
+/// security_dir.
+void secure_lease(DdsConfig& c);
 }  // namespace ddswarm

@@ -1,7 +1,9 @@
 #include "common/dds_config.hpp"
 #include "common/config_reference.hpp"
+#include "common/yaml_section.hpp"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <unistd.h>
 #include <cmath>
@@ -158,6 +160,27 @@ TEST(IdsAboveAgents, NoAgentTakesOrAnnouncesToThemAndTheirPortsAreValid) {
   EXPECT_GT(rtps_unicast_port(0, participant_ids_above_agents(0).back()), 60999);
   // The last domain has no room above 1024 agents: such a participant meets them.
   EXPECT_TRUE(participant_ids_above_agents(232).empty());
+}
+
+TEST(SecureLease, ASecureSwarmOnOneHostTakesTheLongLeaseUnlessTheScenarioNamesOne) {
+  DdsConfig plain;
+  load(YamlSection(YAML::Load("domain_id: 3"), "s.yaml", "dds"), plain);
+  DdsConfig secure = plain;
+  secure.security_dir = "certs";
+  secure_lease(secure);
+  EXPECT_EQ(secure.lease_duration_s, kSecureLeaseS);
+  secure_lease(plain);  // without Security nothing changes
+  EXPECT_EQ(plain.lease_duration_s, 3.0);
+  DdsConfig named;
+  load(YamlSection(YAML::Load("lease_duration_s: 5"), "s.yaml", "dds"), named);
+  named.security_dir = "certs";
+  secure_lease(named);
+  EXPECT_EQ(named.lease_duration_s, 5.0);  // the user's word stands
+  DdsConfig peers = secure;
+  peers.lease_duration_s = 3.0;
+  peers.discovery = Discovery::kPeers;  // an opted-in network: not one host
+  secure_lease(peers);
+  EXPECT_EQ(peers.lease_duration_s, 3.0);
 }
 
 }  // namespace

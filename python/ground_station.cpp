@@ -179,6 +179,7 @@ class GroundStation {
     file_ = gs::load_gs_config(config);
     if (domain) file_.dds.domain_id = *domain;
     if (!secure_dir.empty()) file_.dds.security_dir = secure_dir;
+    secure_lease(file_.dds);
     // As ddswarm-gs: over loopback UDP a new ground station hears the
     // server sooner than over shared memory (ground_station/subcommands.cpp).
     if (!file_.gs.shared_memory) file_.dds.shared_memory = false;
