@@ -41,9 +41,9 @@ int rtps_unicast_port(int domain_id, int participant_id);
 /// domain 0, 62 at domain 232). Fast DDS's automatic ids try only ~100.
 int max_participant_id(int domain_id);
 /// The participant ids, best first, of a participant that meets no agent
-/// (DdsConfig::meets_agents): the domain's highest, whose ports (61000 and up
-/// in domains 0-214) lie above the kernel's ephemeral range and every agent's
-/// id (kAgentParticipantIdBase + drone, drones < 1024); kAboveAgentsIds of
+/// (DdsConfig::meets_agents): the domain's highest ids, above every agent's
+/// (kAgentParticipantIdBase + drone, drones < 1024), whose ports (65470 and
+/// up) lie above the kernel's ephemeral range; kAboveAgentsIds of
 /// them, for that many such participants at once. Empty when the domain's
 /// port range has no room above the agents'.
 std::vector<int> participant_ids_above_agents(int domain_id);
