@@ -240,6 +240,33 @@ ProcessParticipants& process_participants() {
   return p;
 }
 
+/// A participant at the first free id above every agent's, where no agent
+/// announces itself (DdsConfig::meets_agents; others of its kind may hold
+/// some), or nullptr with qos's id automatic again: every id was taken (said
+/// in a warning), or creating it failed for another reason, which the
+/// caller's own attempt then names.
+fdds::DomainParticipant* create_above_agents(fdds::DomainParticipantFactory* factory, int domain_id,
+                                             fdds::DomainParticipantQos& qos,
+                                             fdds::DomainParticipantListener* listener) {
+  auto& id_in_qos = qos.wire_protocol().participant_id;
+  for (const int id : participant_ids_above_agents(domain_id)) {
+    if (participant_id_taken_here(domain_id, id)) continue;
+    id_in_qos = id;
+    if (auto* p = factory->create_participant(domain_id, qos, listener, fdds::StatusMask::none()))
+      return p;
+    if (!participant_id_taken_here(domain_id, id)) {  // not for want of its port
+      id_in_qos = -1;
+      return nullptr;
+    }
+  }
+  spdlog::warn(
+      "no participant id above the agents' is free on domain {}: this participant meets every "
+      "agent",
+      domain_id);
+  id_in_qos = -1;
+  return nullptr;
+}
+
 std::atomic<std::uint64_t> g_write_throws{0};
 std::atomic<std::uint64_t> g_handler_throws{0};
 
@@ -381,29 +408,10 @@ Participant::Participant(const DdsConfig& cfg, const std::string& name) {
     // The watch hears discovery and authentication only (no data status):
     // every reader and writer keeps its own listener.
     peer_watch_ = std::make_unique<PeerWatch>();
-    // Above every agent's id, where no agent announces itself: the first one
-    // free (others of its kind may hold some).
     if (!cfg.meets_agents && cfg.participant_id < 0 && cfg.discovery == Discovery::kLocalhost &&
         !shared_memory_) {
-      bool all_taken = true;
-      for (const int id : participant_ids_above_agents(cfg.domain_id)) {
-        if (participant_id_taken_here(cfg.domain_id, id)) continue;
-        qos.wire_protocol().participant_id = id;
-        participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
-                                                   fdds::StatusMask::none());
-        // Not for want of its port (taken since the look): the error below says why.
-        if (participant_ || !participant_id_taken_here(cfg.domain_id, id)) {
-          all_taken = false;
-          break;
-        }
-      }
+      participant_ = create_above_agents(factory, cfg.domain_id, qos, peer_watch_.get());
       meets_agents_ = !participant_;
-      if (!participant_ && all_taken)
-        spdlog::warn(
-            "no participant id above the agents' is free on domain {}: this participant meets "
-            "every agent",
-            cfg.domain_id);
-      if (!participant_) qos.wire_protocol().participant_id = -1;
     }
     if (!participant_)
       participant_ = factory->create_participant(cfg.domain_id, qos, peer_watch_.get(),
