@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/scenario.hpp"
 #include "common/yaml_section.hpp"
 
 namespace ddswarm {
@@ -53,7 +54,7 @@ PortRange ephemeral_port_range() {
 int max_participant_id(int domain_id) { return (65535 - 1 - rtps_unicast_port(domain_id, 0)) / 2; }
 
 std::vector<int> participant_ids_above_agents(int domain_id) {
-  constexpr int kAboveEveryAgent = kAgentParticipantIdBase + 1024;  // scenario.drones <= 1024
+  constexpr int kAboveEveryAgent = kAgentParticipantIdBase + kMaxDrones;
   std::vector<int> ids;
   for (int id = max_participant_id(domain_id);
        id >= kAboveEveryAgent && static_cast<int>(ids.size()) < kAboveAgentsIds; --id)

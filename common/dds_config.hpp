@@ -42,8 +42,8 @@ int rtps_unicast_port(int domain_id, int participant_id);
 int max_participant_id(int domain_id);
 /// The participant ids, best first, of a participant that meets no agent
 /// (DdsConfig::meets_agents): the domain's highest ids, above every agent's
-/// (kAgentParticipantIdBase + drone, drones < 1024), whose ports (65470 and
-/// up) lie above the kernel's ephemeral range; kAboveAgentsIds of
+/// (kAgentParticipantIdBase + drone, at most kMaxDrones drones), whose ports
+/// (65470 and up) lie above the kernel's ephemeral range; kAboveAgentsIds of
 /// them, for that many such participants at once. Empty when the domain's
 /// port range has no room above the agents'.
 std::vector<int> participant_ids_above_agents(int domain_id);

@@ -8,6 +8,9 @@
 
 namespace ddswarm {
 
+/// The most drones a scenario flies (scenario.drones; the IDL sequences' bound).
+inline constexpr int kMaxDrones = 1024;
+
 enum class TimeMode { kRealtime, kLockstep };
 const char* to_string(TimeMode m);
 
@@ -24,7 +27,7 @@ struct ScenarioConfig {
                                           {"lockstep", TimeMode::kLockstep}};
     v.field("name", c.name, {"", any(), "shown in logs and results"});
     v.field("seed", c.seed, {"", any(), "seeds sensor noise, random starts, comm models and laws"});
-    v.field("drones", c.drones, {"", in(1, 1024), "number of drones, ids 0..drones-1"});
+    v.field("drones", c.drones, {"", in(1, kMaxDrones), "number of drones, ids 0..drones-1"});
     v.choice("mode", c.mode, kModes,
              {"", any(), "realtime: wall-clock paced; lockstep: waits for every agent"});
   }
