@@ -90,6 +90,13 @@ inline constexpr bool kPerDronePartition<msg::VelocityCommand> = true;
 /// tools; agents look for it by name: Participant::peers_named).
 inline constexpr const char* kServerParticipantName = "ddswarm-sim";
 
+/// What ddswarm-record prints once its swarm-state reader has matched a
+/// server's writer. ddswarm-launch and the experiment runner start the agents
+/// only then (ChildSpec::ready_line): a lockstep task flies in a second or two,
+/// and a recorder that matched later missed the flight's start.
+inline constexpr const char* kRecorderMatchedServer =
+    "ddswarm-record: matched the server's swarm state";
+
 /// The per-tick streams, state out and commands back: a newer sample
 /// supersedes a lost one, so in real time the swarm's own readers may read
 /// them best-effort (dds.best_effort_streams, Delivery::kLatest).

@@ -19,6 +19,7 @@
 #include "common/process.hpp"
 #include "common/scenario_check.hpp"
 #include "common/scene.hpp"
+#include "common/topics.hpp"
 #include "experiment/report.hpp"
 #include "ground_station/gs_file_config.hpp"
 #include "launcher/launcher.hpp"
@@ -241,13 +242,22 @@ std::vector<RunPlan> plan_runs(const ExperimentConfig& cfg, const ExperimentOpti
 /// the server, and the agents (one process each, or opt.agent_hosts hosts).
 void start_run_processes(Launcher& procs, const RunPlan& p, int domain, const std::string& bin,
                          const ExperimentOptions& opt) {
-  if (!opt.record_dir.empty()) {
+  const bool recording = !opt.record_dir.empty();
+  if (recording) {
     fs::create_directories(opt.record_dir);
-    procs.start({"record", with_run_dds({bin + "/ddswarm-record", "-o",
-                                         opt.record_dir + "/" + p.tag + ".mcap"},
-                                        domain, opt)});
+    procs.start(
+        {"record",
+         with_run_dds({bin + "/ddswarm-record", "-o", opt.record_dir + "/" + p.tag + ".mcap"},
+                      domain, opt),
+         kRecorderMatchedServer});
   }
   procs.start(server_spec(p, domain, bin, opt));
+  // The recording holds the whole flight: the agents start once it hears the server.
+  if (recording && !procs.wait_ready("record", kRecorderWaitS))
+    std::fprintf(stderr,
+                 "ddswarm-gs: warning: run %s: the recorder has not matched the server's swarm "
+                 "state within %g s; starting the agents anyway\n",
+                 p.tag.c_str(), kRecorderWaitS);
   for (const auto& spec : agent_specs(p, domain, bin, opt)) procs.start(spec);
 }
 

@@ -20,6 +20,7 @@
 #include "common/scenario.hpp"
 #include "common/scenario_overrides.hpp"
 #include "common/scene.hpp"
+#include "common/topics.hpp"
 #include "ground_station/gs_file_config.hpp"
 #include "launcher/preflight.hpp"
 
@@ -367,6 +368,7 @@ int LaunchApp::run() {
   if (start_ds_) start_discovery_server();
   if (!cl_.record_dir.empty()) start_recorder();
   if (cl_.only != "agents") start_server();
+  if (!cl_.record_dir.empty() && cl_.only != "agents") wait_for_recorder();
   warn_about_participant_ids();
   start_agents();
   std::cerr << fmt::format("ddswarm-launch: started {} process(es); policy on death: {}\n",
@@ -404,9 +406,18 @@ void LaunchApp::start_recorder() {
   const std::string out = cl_.record_dir + "/run-" + std::to_string(std::time(nullptr)) + ".mcap";
   std::vector<std::string> a = {bin_ + "/ddswarm-record", "-o", out};
   a.insert(a.end(), dds_args_.begin(), dds_args_.end());
-  procs_->start({"record", a});
+  procs_->start({"record", a, kRecorderMatchedServer});
   std::cerr << "ddswarm-launch: recording to " << out << "\n";
-  wait_for_stop(std::chrono::milliseconds(500));
+}
+
+void LaunchApp::wait_for_recorder() {
+  // The agents start once the recorder hears the server, so the recording
+  // holds the whole flight (a lockstep task flies in a second or two).
+  if (!procs_->wait_ready("record", kRecorderWaitS) && !stopping())
+    std::cerr << fmt::format(
+        "ddswarm-launch: warning: the recorder has not matched the server's swarm state "
+        "within {:g} s; starting the agents anyway (the recording may miss the start)\n",
+        kRecorderWaitS);
 }
 
 void LaunchApp::start_server() { procs_->start({"sim", server_args()}); }

@@ -110,6 +110,8 @@ class LaunchApp {
   std::vector<ChildSpec> agent_specs() const;
   void start_discovery_server();
   void start_recorder();
+  /// Waits (at most kRecorderWaitS) until the recorder hears the server.
+  void wait_for_recorder();
   void start_server();
   void warn_about_participant_ids();
   void start_agents();

@@ -135,6 +135,7 @@ pid_t Launcher::start(const ChildSpec& spec) {
   c->name = spec.name;
   c->pid = pid;
   c->out_fd = out_fd;
+  c->ready_line = spec.ready_line;
   if (!log_dir_.empty()) {
     std::string file = spec.name;
     for (auto& ch : file)
@@ -158,6 +159,21 @@ pid_t Launcher::start(const ChildSpec& spec) {
 void Launcher::rejoin_dropped_participants(const std::string& ds_name) {
   std::lock_guard<std::mutex> lock(mu_);
   drop_watch_ = ds_name;
+}
+
+bool Launcher::wait_ready(const std::string& name, double timeout_s) {
+  const double end = wall_seconds() + timeout_s;
+  for (;;) {
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      const auto it = std::find_if(live_.begin(), live_.end(),
+                                   [&](const auto& kv) { return kv.second->name == name; });
+      if (it == live_.end()) return false;  // reaped (or never started)
+      if (it->second->ready) return true;
+      if (it->second->out_fd < 0) return false;  // its output ended: it has exited
+    }
+    if (wall_seconds() >= end || wait_for_stop(std::chrono::milliseconds(50))) return false;
+  }
 }
 
 void Launcher::on_dropped(const std::array<std::uint8_t, 12>& prefix, bool server_only) {
@@ -190,6 +206,7 @@ void Launcher::emit(Child& c, const char* data, std::size_t n, bool flush) {
          (flush && start < c.partial.size())) {
     std::size_t end = nl == std::string::npos ? c.partial.size() : nl;
     std::string line = c.partial.substr(start, end - start);
+    if (!c.ready_line.empty() && line.find(c.ready_line) != std::string::npos) c.ready = true;
     if (!drop_watch_.empty() && c.name == drop_watch_) {
       if (auto prefix = dropped_participant_prefix(line)) on_dropped(*prefix, false);
       if (auto prefix = unmatched_participant_prefix(line)) on_dropped(*prefix, true);

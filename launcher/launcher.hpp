@@ -24,6 +24,8 @@ namespace ddswarm::gs {
 struct ChildSpec {
   std::string name;               ///< log prefix, e.g. "sim", "agent 3"
   std::vector<std::string> argv;  ///< argv[0] is the executable path
+  /// A line the child prints once it is ready (Launcher::wait_ready); "": none.
+  std::string ready_line = {};
 };
 
 struct ChildExit {
@@ -44,6 +46,10 @@ struct ChildExit {
 bool worth_restarting(const ChildExit& e);
 /// How many times --on-death restart starts one agent again.
 constexpr int kMaxRestarts = 3;
+
+/// How long ddswarm-launch and the experiment runner wait for their recorder
+/// to hear the server (kRecorderMatchedServer) before they start the agents.
+constexpr double kRecorderWaitS = 30.0;
 
 /// --on-death: what the launcher does when one of its processes ends.
 /// kStop: stop everything. kKeep: report it and keep flying. kRestart: start
@@ -115,6 +121,10 @@ class Launcher {
   /// child whose process that participant is gets SIGUSR1 (join again), once
   /// per participant, and the launcher says so on stderr.
   void rejoin_dropped_participants(const std::string& ds_name);
+  /// Waits until child `name` has printed a line holding its spec's
+  /// ready_line, it ended, timeout_s passed or a stop was requested; true
+  /// when it printed it.
+  bool wait_ready(const std::string& name, double timeout_s);
 
   /// Directory of the running executable (where the sibling binaries live).
   static std::string self_dir();
@@ -126,6 +136,8 @@ class Launcher {
     int out_fd;
     std::string partial;
     FILE* log = nullptr;
+    std::string ready_line;  ///< ChildSpec::ready_line
+    bool ready = false;      ///< it printed ready_line
   };
   void pump();
   void emit(Child& c, const char* data, std::size_t n, bool flush);

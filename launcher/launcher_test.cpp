@@ -125,6 +125,26 @@ TEST(Launcher, AsksAnAgentWhoseEndpointsTheDiscoveryServerDroppedToJoinAgain) {
   l.stop_all(0.5);
 }
 
+// ddswarm-launch and the experiment runner start the agents once their
+// recorder says it hears the server (kRecorderMatchedServer).
+TEST(Launcher, WaitsUntilAChildSaysItIsReadyOrEnds) {
+  Launcher l(::testing::TempDir() + "/launcher_ready_logs");
+  l.start({"late",
+           {"/bin/sh", "-c", "echo starting; sleep 0.3; echo now ready here; sleep 30"},
+           "ready here"});
+  l.start({"mute", {"/bin/sleep", "30"}, "ready here"});
+  l.start({"quits", {"/bin/sh", "-c", "echo error: no disk; exit 1"}, "ready here"});
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_TRUE(l.wait_ready("late", 10));
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(250));
+  EXPECT_FALSE(l.wait_ready("mute", 0.3));  // never says it: the timeout ends the wait
+  const auto t1 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(l.wait_ready("quits", 10));  // ended without saying it: no need to wait on
+  EXPECT_LT(std::chrono::steady_clock::now() - t1, std::chrono::seconds(5));
+  EXPECT_FALSE(l.wait_ready("nobody", 10));
+  l.stop_all(1.0);
+}
+
 TEST(Launcher, StopAllLeavesNoChildBehind) {
   std::vector<pid_t> pids;
   {

@@ -17,6 +17,7 @@
 #include <span>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "common/mcap/mcap_reader.hpp"
@@ -68,6 +69,8 @@ struct Recorder::Impl {
   mcap::Writer writer;
   std::unique_ptr<Participant> dds;
   std::vector<std::function<void(Participant&)>> subscriptions;  // one per recorded topic
+  Reader<msg::SwarmState>* state_reader = nullptr;  // this participant's, when recorded
+  bool said_matched = false;                        // kRecorderMatchedServer printed
   int rejoins = 0;
   std::uint64_t duplicates = 0;  // under mu: samples received again after a re-join, kept once
   std::mutex mu;
@@ -114,7 +117,7 @@ struct Recorder::Impl {
       written[topic] = 0;
       SequenceGaps* gaps = &gaps_of[topic];
       subscriptions.push_back([this, channel, gaps](Participant& p) {
-        p.reader<T>(
+        auto& reader = p.reader<T>(
             [this, channel, gaps](const T& sample, const fdds::SampleInfo& info) {
               Item it{channel, now_ns(), static_cast<std::uint64_t>(info.source_timestamp.to_ns()),
                       to_cdr(sample)};
@@ -133,6 +136,7 @@ struct Recorder::Impl {
               cv.notify_one();
             },
             std::nullopt, Delivery::kArchive);
+        if constexpr (std::is_same_v<T, msg::SwarmState>) state_reader = &reader;
       });
     });
     join();
@@ -198,6 +202,10 @@ struct Recorder::Impl {
           join(true);
           ++rejoins;
           lease.restart(wall_seconds());
+        }
+        if (!said_matched && state_reader && state_reader->matched() > 0) {
+          std::fprintf(stderr, "%s\n", kRecorderMatchedServer);
+          said_matched = true;
         }
         {
           std::unique_lock<std::mutex> lock(mu);
