@@ -557,6 +557,7 @@ struct AgentApp::Impl {
       // after SIGCONT in CI, docs/faults.md).
       if (const std::string why = lease.turn(wall_seconds()); !why.empty()) {
         spdlog::warn("{}: {}", label, why);
+        settle_after_stop();
         return AgentApp::End::kOutlivedLease;
       }
       if (take_rejoin_request()) {

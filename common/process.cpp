@@ -112,6 +112,8 @@ std::string LeaseWatch::turn(double now_s) {
   return line;
 }
 
+void settle_after_stop() { wait_for_stop(std::chrono::duration<double>(kSettleAfterStopS)); }
+
 void install_stop_signals() {
   static std::once_flag once;
   std::call_once(once, [] {
@@ -186,8 +188,7 @@ std::int64_t monotonic_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
-void start_again(DeadLockRestart& r, const std::string& what, const std::string& cause,
-                 const std::string& detail);
+void start_again(DeadLockRestart& r, const std::string& why);
 
 // Execs this program again if the exception in flight is the dead owner's
 // lock timeout and the count allows; returns only when it did not.
@@ -203,27 +204,27 @@ void try_dead_lock_restart(DeadLockRestart& r) {
     return;
   }
   if (!is_dead_owner_lock_timeout(what.c_str())) return;
-  start_again(r, "a Fast DDS thread met a shared-memory lock whose owner died",
-              ", a peer killed while holding it", " (" + what + ")");
+  start_again(r,
+              "a Fast DDS thread met a shared-memory lock whose owner died, a peer killed "
+              "while holding it (" +
+                  what + ")");
 }
 
-// Execs this program again, saying why (what, then detail: a cause for the
-// line that restarts, and what happened), unless max_restarts in a row were
-// made already; returns only when it did not.
-void start_again(DeadLockRestart& r, const std::string& what, const std::string& cause,
-                 const std::string& detail) {
+// Execs this program again, saying why in one line, unless max_restarts in a
+// row were made already; returns only when it did not.
+void start_again(DeadLockRestart& r, const std::string& why) {
   const std::int64_t now = monotonic_ns();
   const int n = next_dead_lock_restart(std::getenv(kDeadLockRestartsEnv), now);
   if (n > r.max_restarts) {
-    spdlog::error("{}: {}{}; {} restarts in a row already, so not again", r.prog, what, detail,
+    spdlog::error("{}: {}; {} restarts in a row already, so not again", r.prog, why,
                   r.max_restarts);
     spdlog::default_logger()->flush();
     return;
   }
   spdlog::error(
-      "{}: {}{}{}; starting this process again as a new participant, the same pid ({} of {} in "
-      "a row)",
-      r.prog, what, cause, detail, n, r.max_restarts);
+      "{}: {}; starting this process again as a new participant, the same pid ({} of {} in a "
+      "row)",
+      r.prog, why, n, r.max_restarts);
   spdlog::default_logger()->flush();
   std::fflush(nullptr);
   const std::string count = std::to_string(n) + ":" + std::to_string(now);
@@ -273,7 +274,7 @@ int next_dead_lock_restart(const char* env_value, std::int64_t now_ns) {
   return count + 1;
 }
 
-int dead_owner_lock_restarts() {
+int restarts_in_a_row() {
   int count = 0;
   const char* v = std::getenv(kDeadLockRestartsEnv);
   if (v == nullptr || std::sscanf(v, "%d:", &count) != 1 || count < 0) return 0;
@@ -305,9 +306,9 @@ StuckGuard::StuckGuard(std::string step, double timeout_s) {
       return;
     auto& r = dead_lock_restart();
     if (r.entered.exchange(true)) return;  // a dead lock's restart is under way
-    start_again(r, fmt::format("{} has not ended in {:g} s", step, timeout_s),
-                ": a thread of Fast DDS's is stuck (a deadlock of Fast DDS 2.9's, docs/faults.md)",
-                "");
+    start_again(r, fmt::format("{} has not ended in {:g} s: a thread of Fast DDS's is stuck (a "
+                               "deadlock of Fast DDS 2.9's, docs/faults.md)",
+                               step, timeout_s));
     std::fflush(nullptr);
     std::_Exit(1);  // not again, or the exec failed: end rather than hang
   }).detach();

@@ -36,6 +36,7 @@ Commander& RejoiningCommander::current() {
   }
   if (!why.empty()) {
     log_ << "ddswarm-gs: " << why << "\n" << std::flush;
+    settle_after_stop();
     commander_.reset();  // the old participant leaves before the new one joins
   }
   if (!commander_) {

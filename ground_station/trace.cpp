@@ -89,6 +89,7 @@ void SwarmTrace::run(double duration_s) {
          !impl_->stopping && wall_seconds() < end) {
     if (const std::string why = lease.turn(wall_seconds()); !why.empty()) {
       spdlog::warn("ddswarm-gs trace: {}", why);
+      settle_after_stop();
       impl_->join();
       lease.restart(wall_seconds());
     }

@@ -199,6 +199,7 @@ struct Recorder::Impl {
             spdlog::warn(
                 "ddswarm-record: joining again without the shared-memory transport "
                 "(UDP on 127.0.0.1), which reaches a re-joined participant at once");
+          settle_after_stop();
           join(true);
           ++rejoins;
           lease.restart(wall_seconds());
