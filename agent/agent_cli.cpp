@@ -66,10 +66,10 @@ int run_agent(const AgentAppConfig& cfg, double duration_s, int argc, char** arg
   // A killed server's lock met on a Fast DDS thread would end this agent
   // (docs/faults.md); it starts again instead and catches up with its mission.
   restart_on_dead_owner_lock("ddswarm-agent", argc, argv);
-  if (const int n = dead_owner_lock_restarts(); n > 0)
+  if (const int n = restarts_in_a_row(); n > 0)
     spdlog::warn(
-        "ddswarm-agent: started again after a dead peer's shared-memory lock ({} in a "
-        "row); joining DDS as a new participant and catching up with the mission",
+        "ddswarm-agent: started again ({} in a row; the line before says why); joining DDS as a "
+        "new participant and catching up with the mission",
         n);
   try {
     // A new participant each time no scene came (agent.rejoin_after_s), SIGUSR1 asked for one,
@@ -80,7 +80,7 @@ int run_agent(const AgentAppConfig& cfg, double duration_s, int argc, char** arg
     RejoinPolicy policy(cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
                         cfg.dds.shared_memory && cfg.dds.shm_transport && !cfg.dds.secure(),
                         cfg.agent.handshake_timeout_s);
-    if (dead_owner_lock_restarts() > 0) policy.started_again();
+    if (restarts_in_a_row() > 0) policy.started_again();
     keep_joining(duration_s, [&](double left) {
       auto join = cfg;  // the user's configuration stays as given
       join.agent.rejoin_after_s = policy.scene_wait_s();

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   const std::string mode = argv[1];
   ddswarm::install_stop_signals();
   ddswarm::restart_on_dead_owner_lock("dead_lock_probe", argc, argv, std::atoi(argv[2]));
-  const int runs = ddswarm::dead_owner_lock_restarts();
+  const int runs = ddswarm::restarts_in_a_row();
   std::printf("run %d pid %d fds %d\n", runs, static_cast<int>(getpid()), open_fds_above_2());
   std::fflush(stdout);
   if ((mode == "lock-once" || mode == "stuck-once") && runs >= 1) return 0;

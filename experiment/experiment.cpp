@@ -332,8 +332,10 @@ RunStart start_and_fly(const RunPlan& p, int starts, int domain, const std::stri
 /// A run's CSV row: its plan's, with how its last start ended.
 RunRecord finished_record(RunRecord rec, const RunStart& r, double run_start) {
   rec = with_outcome(std::move(rec), r.o);
-  rec.ok = r.o.ok && r.died.empty();
-  if (!r.died.empty()) rec.failure_reason = r.died;
+  if (!r.died.empty()) {  // a process died: the run failed, whatever the task said
+    rec.ok = false;
+    rec.failure_reason = r.died;
+  }
   rec.wall_time_s = wall_seconds() - run_start;
   return rec;
 }

@@ -38,7 +38,7 @@ grep -q "task failed: server restarted" "$WORK/gstask.log" || fail "the reason i
 # shared-memory port held by the dead server, docs/faults.md), has no old
 # mission to reset. That rule waits twice the lease (6 s) from the new
 # server's announcement; allow for it.
-reset='mission reset|started again after a dead peer|a new server announced itself'
+reset='mission reset|ddswarm-agent: started again|a new server announced itself'
 for i in 0 1 2 3 4 5; do
   for _ in $(seq 150); do grep -qE "$reset" "$WORK/agent_$i.log" && break; sleep 0.1; done
   grep -qE "$reset" "$WORK/agent_$i.log" || fail "agent $i did not reset its mission for the new server"
