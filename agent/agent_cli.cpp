@@ -79,7 +79,7 @@ int run_agent(const AgentAppConfig& cfg, double duration_s, int argc, char** arg
     // agent was cut off, leaves the shared-memory transport out (docs/faults.md).
     RejoinPolicy policy(cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
                         cfg.dds.shared_memory && cfg.dds.shm_transport && !cfg.dds.secure(),
-                        cfg.agent.handshake_timeout_s);
+                        handshake_timeout_for(cfg.agent.handshake_timeout_s, cfg.scenario.drones));
     if (restarts_in_a_row() > 0) policy.started_again();
     keep_joining(duration_s, [&](double left) {
       auto join = cfg;  // the user's configuration stays as given

@@ -12,6 +12,11 @@ double RejoinPolicy::scene_wait_s() const {
   return wait;
 }
 
+double handshake_timeout_for(double handshake_timeout_s, int drones) {
+  if (handshake_timeout_s <= 0) return 0;
+  return std::max(handshake_timeout_s, kHandshakeSecondsPerDrone * drones);
+}
+
 double RejoinPolicy::handshake_wait_s() const {
   return rejoin_patience_s(handshake_s_, handshake_stalls_);
 }

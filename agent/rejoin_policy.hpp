@@ -5,6 +5,19 @@
 
 namespace ddswarm::agent {
 
+/// Under DDS Security the server authenticates every agent of the swarm, and
+/// on a loaded machine their handshakes queue: a handshake may take this long
+/// per drone of the scenario before it counts as stalled. At 128 secure drones
+/// on 2 cores the 10 s default made 107 agents join again in one bring-up,
+/// each a handshake more, and the swarm never came up; with a 90 s timeout
+/// the same launch had 122 agents online 10 s into the wait and took off
+/// (docs/security.md, "Large secure swarms").
+inline constexpr double kHandshakeSecondsPerDrone = 0.5;
+
+/// agent.handshake_timeout_s as a swarm of `drones` uses it: 0 stays 0
+/// (never), any other value is at least kHandshakeSecondsPerDrone * drones.
+double handshake_timeout_for(double handshake_timeout_s, int drones);
+
 class RejoinPolicy {
  public:
   /// A join right after one that had the scene (the swarm is up) waits at
