@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "agent/rejoin_policy.hpp"
+#include "common/agent_rejoin.hpp"
 #include "common/cli_checks.hpp"
 #include "common/config_error.hpp"
 #include "common/id_ranges.hpp"
@@ -77,9 +78,11 @@ int run_agent(const AgentAppConfig& cfg, double duration_s, int argc, char** arg
     // it did not hear the server, or a secure server's handshake did not end
     // (agent.handshake_timeout_s). RejoinPolicy sets each join's waits and, once this
     // agent was cut off, leaves the shared-memory transport out (docs/faults.md).
-    RejoinPolicy policy(cfg.agent.rejoin_after_s, cfg.dds.lease_duration_s,
+    const int drones = cfg.scenario.drones;
+    RejoinPolicy policy(rejoin_after_for(cfg.agent.rejoin_after_s, drones, cfg.dds.secure()),
+                        cfg.dds.lease_duration_s,
                         cfg.dds.shared_memory && cfg.dds.shm_transport && !cfg.dds.secure(),
-                        handshake_timeout_for(cfg.agent.handshake_timeout_s, cfg.scenario.drones));
+                        handshake_timeout_for(cfg.agent.handshake_timeout_s, drones));
     if (restarts_in_a_row() > 0) policy.started_again();
     keep_joining(duration_s, [&](double left) {
       auto join = cfg;  // the user's configuration stays as given

@@ -7,12 +7,13 @@ namespace ddswarm::agent {
 
 /// Under DDS Security the server authenticates every agent of the swarm, and
 /// on a loaded machine their handshakes queue: a handshake may take this long
-/// per drone of the scenario before it counts as stalled. At 128 secure drones
-/// on 2 cores the 10 s default made 107 agents join again in one bring-up,
-/// each a handshake more, and the swarm never came up; with a 90 s timeout
-/// the same launch had 122 agents online 10 s into the wait and took off
-/// (docs/security.md, "Large secure swarms").
-inline constexpr double kHandshakeSecondsPerDrone = 0.5;
+/// per drone of the scenario before it counts as stalled, and a secure agent
+/// with the scene waits as long for the swarm state (JoinPatience::deaf_s).
+/// At 128 secure drones on 2 cores the 10 s default made 107 agents join
+/// again in one bring-up, each a handshake more, and the swarm never came up;
+/// at 0.5 s a drone (64 s) 12 agents still heard no swarm state in time; with
+/// 90 s the swarm took off (docs/security.md, "Large secure swarms").
+inline constexpr double kHandshakeSecondsPerDrone = 0.75;
 
 /// agent.handshake_timeout_s as a swarm of `drones` uses it: 0 stays 0
 /// (never), any other value is at least kHandshakeSecondsPerDrone * drones.

@@ -89,12 +89,12 @@ TEST(RejoinPolicy, HandshakeStallsInARowWaitTwiceAsLongEachTime) {
 }
 
 // A large secure swarm's handshakes queue at the server: the timeout grows
-// with the scenario's drones (0.5 s each), never below the configured value,
+// with the scenario's drones (0.75 s each), never below the configured value,
 // and 0 (never) stays never.
 TEST(RejoinPolicy, HandshakeTimeoutGrowsWithTheSwarm) {
   EXPECT_DOUBLE_EQ(handshake_timeout_for(10.0, 6), 10.0);
-  EXPECT_DOUBLE_EQ(handshake_timeout_for(10.0, 64), 32.0);
-  EXPECT_DOUBLE_EQ(handshake_timeout_for(10.0, 128), 64.0);
+  EXPECT_DOUBLE_EQ(handshake_timeout_for(10.0, 64), 48.0);
+  EXPECT_DOUBLE_EQ(handshake_timeout_for(10.0, 128), 96.0);
   EXPECT_DOUBLE_EQ(handshake_timeout_for(100.0, 128), 100.0);
   EXPECT_DOUBLE_EQ(handshake_timeout_for(0.0, 128), 0.0);
 }

@@ -20,6 +20,24 @@ constexpr double longest_scene_wait_s(double rejoin_after_s) {
   return rejoin_after_s * (1.0 + kRejoinSpread);
 }
 
+/// Under DDS Security the server authenticates each agent and then exchanges
+/// keys with it for every topic, and on a loaded machine the agents queue for
+/// it: a secure agent waits for the scene at least this long per drone of the
+/// scenario. 128 secure drones on 2 cores with the 40 s default: 84 agents
+/// authenticated within about a second heard no scene within 40-60 s, joined
+/// again (each a handshake more) and the swarm never came up; with 120 s the
+/// same launch took off (docs/security.md, "Large secure swarms").
+inline constexpr double kSecureSceneSecondsPerDrone = 1.0;
+
+/// agent.rejoin_after_s as an agent of a swarm of `drones` uses it: as given
+/// without security, and 0 (never) stays 0; otherwise at least
+/// kSecureSceneSecondsPerDrone * drones.
+constexpr double rejoin_after_for(double rejoin_after_s, int drones, bool secure) {
+  if (!secure || rejoin_after_s <= 0) return rejoin_after_s;
+  const double floor = kSecureSceneSecondsPerDrone * drones;
+  return rejoin_after_s > floor ? rejoin_after_s : floor;
+}
+
 /// agent.rejoin_after_s of a scenario file; kDefaultRejoinAfterS when the file
 /// names none, or when it or that value cannot be read (the agents name a bad
 /// section themselves). Never throws.

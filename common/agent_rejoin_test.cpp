@@ -23,6 +23,16 @@ TEST(AgentRejoin, LongestSceneWaitIsTheSpreadAboveRejoinAfter) {
   EXPECT_DOUBLE_EQ(longest_scene_wait_s(0.0), 0.0);
 }
 
+// Under DDS Security agents queue for the server's key exchanges: at least
+// 1 s per drone for the scene; without security, or at 0 (never), as given.
+TEST(AgentRejoin, SecureSwarmsWaitLongerForTheScene) {
+  EXPECT_DOUBLE_EQ(rejoin_after_for(40.0, 128, false), 40.0);
+  EXPECT_DOUBLE_EQ(rejoin_after_for(40.0, 6, true), 40.0);
+  EXPECT_DOUBLE_EQ(rejoin_after_for(40.0, 128, true), 128.0);
+  EXPECT_DOUBLE_EQ(rejoin_after_for(200.0, 128, true), 200.0);
+  EXPECT_DOUBLE_EQ(rejoin_after_for(0.0, 128, true), 0.0);
+}
+
 TEST(AgentRejoin, ReadsTheScenariosValue) {
   const auto p = write_scenario("set", "scenario:\n  drones: 3\nagent:\n  rejoin_after_s: 12\n");
   EXPECT_DOUBLE_EQ(scenario_rejoin_after_s(p), 12.0);

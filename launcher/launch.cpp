@@ -106,10 +106,11 @@ std::vector<std::string> split_script(const std::string& s) {
   return out;
 }
 
-double agents_wait_s(const std::string& scenario) {
+double agents_wait_s(const std::string& scenario, int drones, bool secure) {
   // A fixed 30 s would give up on an agent cut off at start-up that comes
   // back at 40-60 s (mp_comm_task).
-  return 30.0 + std::max(longest_scene_wait_s(scenario_rejoin_after_s(scenario)), 0.0);
+  const double rejoin_after = rejoin_after_for(scenario_rejoin_after_s(scenario), drones, secure);
+  return 30.0 + std::max(longest_scene_wait_s(rejoin_after), 0.0);
 }
 
 LaunchApp::LaunchApp(const CLI::App& app, LaunchCommandLine cl)
@@ -475,7 +476,7 @@ int LaunchApp::supervise() {
   int rc = 0;
   if (!cl_.gs_script.empty()) {
     std::vector<std::string> steps = {fmt::format("wait-agents --count {} --timeout {:g}",
-                                                  ids_.size(), agents_wait_s(cl_.scenario))};
+                                                  ids_.size(), agents_wait_s(cl_.scenario, n_, dds_.secure()))};
     for (const auto& s : split_script(cl_.gs_script)) steps.push_back(s);
     for (const auto& step : steps) {
       if (stopping() || death_policy_->stop()) break;

@@ -46,8 +46,9 @@ std::vector<std::string> split_script(const std::string& s);
 
 /// How long --gs waits for the agents before its first step: the bring-up,
 /// plus the longest first join of an agent that heard no scene before it came
-/// back as a new participant (agent.rejoin_after_s, common/agent_rejoin.hpp).
-double agents_wait_s(const std::string& scenario);
+/// back as a new participant (agent.rejoin_after_s as a swarm of `drones`,
+/// secure or not, uses it: rejoin_after_for, common/agent_rejoin.hpp).
+double agents_wait_s(const std::string& scenario, int drones, bool secure);
 
 /// A file removed when this goes (a launch's scenario copy outside its log
 /// directory): at a normal end, at an error, and after SIGINT or SIGTERM,

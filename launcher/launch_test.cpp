@@ -42,14 +42,22 @@ TEST(SplitScript, TrimsEachStepAndDropsEmptyOnes) {
 }
 
 TEST(AgentsWait, IsTheBringUpPlusTheLongestFirstJoin) {
-  EXPECT_DOUBLE_EQ(agents_wait_s(kScenario), 90.0);  // agent.rejoin_after_s 40 by default
+  EXPECT_DOUBLE_EQ(agents_wait_s(kScenario, 6, false), 90.0);  // agent.rejoin_after_s 40 by default
   const auto dir = temp_dir("wait");
   const auto p = (dir / "s.yaml").string();
   std::ofstream(p) << "scenario:\n  drones: 2\nagent:\n  rejoin_after_s: 10\n";
-  EXPECT_DOUBLE_EQ(agents_wait_s(p), 45.0);
+  EXPECT_DOUBLE_EQ(agents_wait_s(p, 2, false), 45.0);
   std::ofstream(p) << "scenario:\n  drones: 2\nagent:\n  rejoin_after_s: 0\n";
-  EXPECT_DOUBLE_EQ(agents_wait_s(p), 30.0);  // agents that never join again
+  EXPECT_DOUBLE_EQ(agents_wait_s(p, 2, false), 30.0);  // agents that never join again
   std::filesystem::remove_all(dir);
+}
+
+// A secure swarm's agents wait for the scene 1 s per drone at least, and the
+// launcher's first wait follows: 30 s + 1.5 x 128 s at 128 drones.
+TEST(AgentsWait, FollowsASecureSwarmsLongerSceneWait) {
+  EXPECT_DOUBLE_EQ(agents_wait_s(kScenario, 6, true), 90.0);
+  EXPECT_DOUBLE_EQ(agents_wait_s(kScenario, 128, false), 90.0);
+  EXPECT_DOUBLE_EQ(agents_wait_s(kScenario, 128, true), 222.0);
 }
 
 TEST(LaunchApp, RefusesWhatItCannotStartBeforeStartingAnything) {
