@@ -17,6 +17,7 @@
 #include "experiment/compare.hpp"
 #include "experiment/experiment.hpp"
 #include "experiment/report.hpp"
+#include "ground_station/growing_wait.hpp"
 #include "ground_station/line_reader.hpp"
 #include "ground_station/menu.hpp"
 #include "ground_station/rejoining_commander.hpp"
@@ -370,21 +371,29 @@ int console(std::unique_ptr<DdsCommander> commander, const GsFileConfig& file) {
 int wait_agents_command(DdsCommander& gs, int wait_count, double wait_timeout) {
   // The server's view decides: the next command is another process, which
   // waits for its own connections to the agents (wait_for_server).
-  // In slices, saying how far it got: a large or a slow swarm takes a while.
+  // In slices, saying how far it got: a large or a slow swarm takes a while,
+  // and past --timeout it waits on while agents keep coming (GrowingWait).
   constexpr double kProgressS = 10.0;
   const double t0 = wall_seconds();
+  GrowingWait wait(t0, wait_timeout, kAgentsGrowingS);
   bool ok = false;
   for (;;) {
-    const double left = wait_timeout - (wall_seconds() - t0);
-    ok = gs.wait_for_online(wait_count, std::clamp(left, 0.0, kProgressS));
-    if (ok || left <= kProgressS || stop_requested()) break;
+    const double left = wait.until_s() - wall_seconds();
+    if (left <= 0) break;
+    ok = gs.wait_for_online(wait_count, std::min(left, kProgressS));
+    if (ok || stop_requested()) break;
     const SwarmStatus now = gs.status();
-    std::fprintf(
-        stderr,
-        "ddswarm-gs: waiting for agents: the server hears %d of %d after %.0f s (of %g s)\n",
-        std::max(now.drones_server_hears, 0), wait_count < 0 ? now.drones_total : wait_count,
-        wall_seconds() - t0, wait_timeout);
+    const double at = wall_seconds();
+    wait.saw(now.drones_server_hears, at);
+    if (wait.until_s() - at <= 0) break;
+    std::fprintf(stderr,
+                 "ddswarm-gs: waiting for agents: the server hears %d of %d after %.0f s (of %g "
+                 "s%s)\n",
+                 std::max(now.drones_server_hears, 0),
+                 wait_count < 0 ? now.drones_total : wait_count, at - t0, wait_timeout,
+                 wait.past_timeout(at) ? "; more keep coming" : "");
   }
+  const double waited = wall_seconds() - t0;
   auto st = gs.status();
   if (ok) {
     std::printf("%d/%d agents online\n", st.drones_online, st.drones_total);
@@ -399,9 +408,13 @@ int wait_agents_command(DdsCommander& gs, int wait_count, double wait_timeout) {
         wait_timeout, st.drones_online, st.drones_total);
   else
     std::printf(
-        "timed out after %g s: the server hears %d of the %d agents asked for (this "
-        "ground station hears %d/%d online)\n",
-        wait_timeout, st.drones_server_hears, asked, st.drones_online, st.drones_total);
+        "timed out after %s: the server hears %d of the %d agents asked for (this ground "
+        "station hears %d/%d online)\n",
+        (wait.extended() ? fmt::format("{:.0f} s (--timeout {:g}, then no new agent for {:g} s)",
+                                       waited, wait_timeout, kAgentsGrowingS)
+                         : fmt::format("{:g} s", wait_timeout))
+            .c_str(),
+        st.drones_server_hears, asked, st.drones_online, st.drones_total);
   return 1;
 }
 

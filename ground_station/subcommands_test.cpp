@@ -12,6 +12,7 @@
 #include "common/participant.hpp"
 #include "common/process.hpp"
 #include "experiment/report.hpp"
+#include "ground_station/growing_wait.hpp"
 #include "ground_station/trace.hpp"
 #include "ground_station/web/web_bridge.hpp"
 
@@ -122,6 +123,34 @@ TEST(CompareExperiments, SameRunsDoNotDifferAndBadArgumentsAreRefused) {
 
 /// A random DDS domain in 80-99 (as dds_commander_test: apart from the other unit tests').
 int random_test_domain() { return 95 + static_cast<int>(random_instance() % 5); }
+
+// Past its timeout a wait goes on while the count reaches new highs, for
+// the grace after each; a count that never rose, or stopped rising, ends it.
+TEST(GrowingWait, WaitsOnWhileTheCountGrows) {
+  GrowingWait w(0.0, 90.0, 30.0);
+  EXPECT_DOUBLE_EQ(w.until_s(), 90.0);
+  w.saw(-1, 10.0);  // no server
+  w.saw(20, 50.0);  // where it starts from
+  EXPECT_DOUBLE_EQ(w.until_s(), 90.0);
+  w.saw(40, 80.0);
+  EXPECT_DOUBLE_EQ(w.until_s(), 110.0);
+  EXPECT_FALSE(w.past_timeout(89.0));
+  EXPECT_TRUE(w.past_timeout(100.0));
+  w.saw(40, 100.0);  // the same count is no growth
+  EXPECT_DOUBLE_EQ(w.until_s(), 110.0);
+  w.saw(35, 105.0);  // agents that left and join again
+  w.saw(39, 107.0);  // ... and come back: below the high, no growth
+  EXPECT_DOUBLE_EQ(w.until_s(), 110.0);
+  w.saw(90, 108.0);
+  EXPECT_DOUBLE_EQ(w.until_s(), 138.0);
+  GrowingWait early(0.0, 90.0, 30.0);
+  early.saw(3, 5.0);
+  early.saw(128, 10.0);  // growth long before the timeout does not shorten it
+  EXPECT_DOUBLE_EQ(early.until_s(), 90.0);
+  GrowingWait flat(0.0, 11.0, 30.0);
+  flat.saw(3, 10.0);  // 3 of 4 from the first look: nothing more is coming
+  EXPECT_DOUBLE_EQ(flat.until_s(), 11.0);
+}
 
 TEST(WaitAgents, WithNoServerTimesOutSayingWhoseViewItIs) {
   DdsConfig dds;
