@@ -25,7 +25,9 @@ class GrowingWait {
     high_ = std::max(high_, count);
   }
   /// When the wait gives up, as of what it has seen.
-  double until_s() const { return rose_ ? std::max(timeout_at_, rose_at_ + grace_s_) : timeout_at_; }
+  double until_s() const {
+    return rose_ ? std::max(timeout_at_, rose_at_ + grace_s_) : timeout_at_;
+  }
   /// Whether growth moved the end past the timeout.
   bool extended() const { return until_s() > timeout_at_; }
   /// Whether now_s lies past the timeout (the wait goes on for growth alone).

@@ -476,7 +476,8 @@ int LaunchApp::supervise() {
   int rc = 0;
   if (!cl_.gs_script.empty()) {
     std::vector<std::string> steps = {fmt::format("wait-agents --count {} --timeout {:g}",
-                                                  ids_.size(), agents_wait_s(cl_.scenario, n_, dds_.secure()))};
+                                                  ids_.size(),
+                                                  agents_wait_s(cl_.scenario, n_, dds_.secure()))};
     for (const auto& s : split_script(cl_.gs_script)) steps.push_back(s);
     for (const auto& step : steps) {
       if (stopping() || death_policy_->stop()) break;
