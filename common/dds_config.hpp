@@ -93,6 +93,12 @@ constexpr double kSecureLeaseS = 20.0;
 /// before its lease has passed is never checked, so never races.
 constexpr double kOneShotLeaseS = 20.0;
 
+/// The UDP sockets' send and receive buffers every participant asks for:
+/// room for a whole swarm's state, many ticks of it while a reader is busy.
+/// Linux gives at most net.core.rmem_max (212,992 bytes by default), and
+/// says nothing; the recorder warns when it is less (docs/recording.md).
+constexpr std::uint32_t kUdpSocketBufferBytes = 2u << 20;
+
 /// The shared-memory transport's segment of every process but an agent: its
 /// outbox, where each sample it sends by that transport waits until every
 /// local reader has taken it. The server's whole-swarm state, which a

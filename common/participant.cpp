@@ -159,8 +159,8 @@ fdds::DomainParticipantQos make_qos(const DdsConfig& cfg, const std::string& nam
   udp->interfaceWhiteList.clear();
   udp->interfaceWhiteList.emplace_back(kLoopback);
   // Room for the whole swarm's state in one UDP datagram train; large samples fragment.
-  udp->sendBufferSize = 1 << 21;
-  udp->receiveBufferSize = 1 << 21;
+  udp->sendBufferSize = kUdpSocketBufferBytes;
+  udp->receiveBufferSize = kUdpSocketBufferBytes;
 
   switch (cfg.discovery) {
     case Discovery::kLocalhost:

@@ -49,6 +49,17 @@ std::vector<std::uint8_t> to_cdr(const T& sample) {
   return std::vector<std::uint8_t>(payload.data, payload.data + payload.length);
 }
 
+/// net.core.rmem_max, the most a UDP socket's receive buffer may hold; 0
+/// when it cannot be read.
+long udp_receive_buffer_cap() {
+  long bytes = 0;
+  if (std::FILE* f = std::fopen("/proc/sys/net/core/rmem_max", "r")) {
+    if (std::fscanf(f, "%ld", &bytes) != 1) bytes = 0;
+    std::fclose(f);
+  }
+  return bytes;
+}
+
 std::set<std::string> all_topics() {
   std::set<std::string> out;
   for_each_topic_type([&]<class T>() { out.insert(Topic<T>::name); });
@@ -140,19 +151,29 @@ struct Recorder::Impl {
       });
     });
     join();
+    if (const long cap = udp_receive_buffer_cap(); cap > 0 && cap < kUdpSocketBufferBytes)
+      spdlog::warn(
+          "ddswarm-record: net.core.rmem_max is {} bytes, less than the {} the recorder asks "
+          "for its UDP socket: a recorder held up for longer than that buffer lasts loses swarm "
+          "states, counted as never received (sysctl -w net.core.rmem_max={} raises it)",
+          cap, kUdpSocketBufferBytes, kUdpSocketBufferBytes);
   }
 
   /// A new participant with every reader. The old one, if any, is closed
-  /// first: no callback of it runs afterwards. After a stop longer than the
-  /// lease (again: true) it joins without the shared-memory transport, as an
-  /// agent does once cut off: on a loaded machine (one core of two busy), a
-  /// recorder re-joined on shared memory heard no swarm state for about 3 s
-  /// in 5 stops of 6, and by UDP on 127.0.0.1 within the first second in 6
-  /// of 6 (docs/faults.md).
-  void join(bool again = false) {
+  /// first: no callback of it runs afterwards. It never takes the
+  /// shared-memory transport, so every sample comes by UDP (on 127.0.0.1
+  /// unless dds names a network): a recorder sends acknowledgements to every
+  /// writer it reads, and Fast DDS 2.9's shared-memory transport sleeps a
+  /// third of dds.shm_health_check_s (3.3 s) when it opens a peer's port
+  /// whose idle listener was just checked, holding every send of the
+  /// participant. A recorder on shared memory went deaf for 3.3 s when a
+  /// participant joined (the soak's hostile publisher), then lost 18 swarm
+  /// states its KEEP_LAST 1 writer could not send again; one re-joined after
+  /// a stop heard nothing for about 3 s in 5 stops of 6 (docs/recording.md).
+  void join() {
     dds.reset();  // the old participant leaves before the new one joins
     DdsConfig cfg = dds_cfg;
-    if (again) cfg.shm_transport = false;
+    cfg.shm_transport = false;
     dds = std::make_unique<Participant>(cfg, "ddswarm-record");
     for (const auto& subscribe : subscriptions) subscribe(*dds);
   }
@@ -195,12 +216,8 @@ struct Recorder::Impl {
           spdlog::warn(
               "ddswarm-record: {}; what no writer kept meanwhile is counted as never received",
               why);
-          if (rejoins == 0 && dds_cfg.shared_memory && dds_cfg.shm_transport)
-            spdlog::warn(
-                "ddswarm-record: joining again without the shared-memory transport "
-                "(UDP on 127.0.0.1), which reaches a re-joined participant at once");
           settle_after_stop();
-          join(true);
+          join();
           ++rejoins;
           lease.restart(wall_seconds());
         }

@@ -15,6 +15,10 @@ start trace "$BIN/ddswarm-gs" --config "$scenario" --domain "$DOMAIN" trace --ou
 gs wait-agents --count 6 --timeout 60 || fail "agents not online"
 gs takeoff --wait || fail "takeoff"
 
+# The recorder reads by UDP on 127.0.0.1, never by the shared-memory
+# transport, whose port opening can hold its sends for 3.3 s
+# (docs/recording.md): it maps no transport segment or port.
+! grep -q '/dev/shm/fastrtps_' "/proc/$PID_rec/maps" || fail "the recorder maps a shared-memory transport file"
 kill -STOP "$PID_rec" "$PID_trace"
 sleep 6  # twice the 3 s lease
 kill -CONT "$PID_rec" "$PID_trace"
@@ -41,8 +45,6 @@ grep -q "joining again as a new participant" "$WORK/rec.log" ||
   fail "the recorder outlived its 3 s lease but did not join again"
 grep -Eq "ddswarm/swarm_state +[0-9]+ \([0-9]+ more were sent but never received\)" "$WORK/rec.log" ||
   fail "the swarm states sent while the recorder was stopped are not counted as missed"
-grep -q "joining again without the shared-memory transport" "$WORK/rec.log" ||
-  fail "the recorder re-joined on shared memory"
 grep -Eq "joined DDS again 1 time\(s\).*; [0-9]+ samples received twice were kept once" "$WORK/rec.log" ||
   fail "the recorder does not report its re-join"
 
@@ -52,7 +54,7 @@ after=$(awk -v t="$resumed_ns" '$2 == "ddswarm/swarm_state" && $1 > t + 20000000
   "$WORK/run.info" | wc -l)
 echo "swarm states recorded from 2 s after SIGCONT: $after"
 # 50 Hz: ~150 in those 3 s. Re-joined on shared memory on a loaded machine,
-# the recorder hears none for about 4 s after SIGCONT in 5 runs of 6 (then
+# a recorder heard none for about 4 s after SIGCONT in 5 runs of 6 (then
 # about 30 states in these 3 s); by UDP it hears them at once.
 [ "$after" -ge 100 ] || fail "the recorder did not hear the swarm again after SIGCONT ($after states in 3 s)"
 scenes=$(awk '$2 == "ddswarm/scene"' "$WORK/run.info" | wc -l)
