@@ -61,6 +61,10 @@ struct JoinPatience {
   /// twice the lease; under DDS Security at least handshake_timeout_s, since
   /// the swarm state's key exchange comes after the scene's.
   double deaf_s(bool secure) const;
+  /// How long a lost server may stay silent and unmatched, with no other
+  /// server in sight, before a new participant looks for it: the longer of
+  /// scene_wait_s and 20 leases (60 s by default).
+  double lost_server_s() const;
 };
 
 struct JoinVerdict {
@@ -78,8 +82,8 @@ bool lost_server_gone(const JoinView& v);
 
 /// The first rule that ends this join, in the order docs/faults.md gives
 /// ("Why an agent joins again"):
-/// unheard, deaf to a live server, deaf to a new server, a stalled secure
-/// handshake, no scene. nullopt: keep flying.
+/// unheard, deaf to a live server, deaf to a new server, a lost server
+/// silent and unmatched, a stalled secure handshake, no scene. nullopt: keep flying.
 std::optional<JoinVerdict> why_join_again(const JoinView& v, const JoinPatience& p);
 
 }  // namespace ddswarm::agent

@@ -219,4 +219,35 @@ TEST(JoinWatch, TheMostSpecificRuleSpeaks) {
 }
 
 }  // namespace
+
+// The 64-drone soak: a new server stalled 3.3 s as it started; agents that
+// lost it had the scene, the server's scene writer unmatched, no other
+// server, and stayed unheard for 5 minutes. After 20 leases (60 s) a new
+// participant looks for it; a shorter silence, or one with another server
+// coming, is left to the other rules.
+TEST(JoinWatch, ALostServerSilentAndUnmatchedForLongIsLookedForAfresh) {
+  JoinView v = flying();
+  v.server_lost = true;
+  v.scene_writer_matched = false;
+  v.last_state_s = 100 - 59.9;
+  EXPECT_FALSE(why_join_again(v, patience()));
+  v.last_state_s = 100 - 60.1;
+  const auto verdict = why_join_again(v, patience());
+  ASSERT_TRUE(verdict);
+  EXPECT_EQ(verdict->end, JoinEnd::kDeaf);
+  EXPECT_NE(verdict->why.find("the server has been silent for 60.1 s"), std::string::npos)
+      << verdict->why;
+  JoinView matched = v;  // still matched: the deaf-to-a-live-server rule's, after 6 s
+  matched.scene_writer_matched = true;
+  ASSERT_TRUE(why_join_again(matched, patience()));
+  EXPECT_EQ(why_join_again(matched, patience())->why.find("the server has been silent"),
+            std::string::npos);
+  JoinPatience never = patience();  // agent.rejoin_after_s: 0, never
+  never.scene_wait_s = 0;
+  EXPECT_FALSE(why_join_again(v, never));
+  JoinPatience slow = patience();  // a longer scene wait is the longer wait
+  slow.scene_wait_s = 90;
+  EXPECT_FALSE(why_join_again(v, slow));
+}
+
 }  // namespace ddswarm::agent
